@@ -1,0 +1,1 @@
+//! URDF → floating-base model: forward kinematics, frame and CoM Jacobians, inverse kinematics.

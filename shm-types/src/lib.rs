@@ -1,0 +1,1 @@
+//! The wire contract between `walkd`, its adapters and its clients (DESIGN.md §6).

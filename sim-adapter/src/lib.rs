@@ -1,0 +1,1 @@
+//! `walk-sim`: simulated robots behind the adapter side of the IPC contract.
