@@ -1,0 +1,469 @@
+//! A robot = a model plus what the `[robot]` section of `configs/<robot>.toml` says about it:
+//! end-effector frames, sole size, FT sensor frames, joint groups and the standing posture.
+//!
+//! The section (every key required unless marked optional; unknown keys are errors):
+//! ```toml
+//! [robot]
+//! name = "jvrc1"
+//! urdf = "robots/jvrc1/jvrc1.urdf"      # optional, relative to the TOML; `--urdf` overrides
+//! base_link = "PELVIS_S"
+//! sole = { length = 0.20, width = 0.08 }
+//!
+//! [robot.frames]                          # link + translation + rpy (the pose in the link frame)
+//! left_foot = { link = "L_ANKLE_P_S", translation = [0.03, 0.0, -0.1077], rpy = [0.0, 0.0, 0.0] }
+//! # right_foot, left_hand, right_hand likewise
+//!
+//! [robot.ft_sensors]
+//! left = { link = "lfsensor" }            # translation / rpy default to zero
+//! right = { link = "rfsensor" }
+//!
+//! [robot.joint_groups]
+//! legs = ["R_HIP_P", ...]
+//! arms = [...]
+//! torso = [...]
+//! head = [...]
+//!
+//! [robot.standing]                        # joint name → angle; joints not named are 0
+//! R_KNEE = 0.6
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use serde::Deserialize;
+
+use crate::configuration::Configuration;
+use crate::kinematics::Kinematics;
+use crate::model::{FrameId, LinkId, Model, ModelError, pose_from_xyz_rpy};
+
+/// The four end-effectors a stance can put in contact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum EndEffector {
+    /// Left sole.
+    LeftFoot = 0,
+    /// Right sole.
+    RightFoot = 1,
+    /// Left palm.
+    LeftHand = 2,
+    /// Right palm.
+    RightHand = 3,
+}
+
+impl EndEffector {
+    /// All end-effectors, in index order.
+    pub const ALL: [EndEffector; 4] = [
+        EndEffector::LeftFoot,
+        EndEffector::RightFoot,
+        EndEffector::LeftHand,
+        EndEffector::RightHand,
+    ];
+
+    /// The config key and frame name (`left_foot`, `right_foot`, `left_hand`, `right_hand`).
+    pub fn name(self) -> &'static str {
+        match self {
+            EndEffector::LeftFoot => "left_foot",
+            EndEffector::RightFoot => "right_foot",
+            EndEffector::LeftHand => "left_hand",
+            EndEffector::RightHand => "right_hand",
+        }
+    }
+
+    /// Whether this is a foot.
+    pub fn is_foot(self) -> bool {
+        matches!(self, EndEffector::LeftFoot | EndEffector::RightFoot)
+    }
+}
+
+/// Sole contact rectangle, centred on the sole frame origin, x forward, y left, in the sole
+/// frame's xy plane (the sole frame sits on the sole surface, z up when standing flat).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SoleRectangle {
+    /// Extent along the sole frame's x axis (m).
+    pub length: f64,
+    /// Extent along the sole frame's y axis (m).
+    pub width: f64,
+}
+
+/// Joint indices (model order) of each body part, for posture tasks and stance retargeting.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct JointGroups {
+    /// Both legs.
+    pub legs: Vec<usize>,
+    /// Both arms (including hands).
+    pub arms: Vec<usize>,
+    /// Waist / chest.
+    pub torso: Vec<usize>,
+    /// Neck and head.
+    pub head: Vec<usize>,
+}
+
+/// Names of the FT sensor frames added to the model.
+pub const FT_SENSOR_FRAMES: [&str; 2] = ["left_ft_sensor", "right_ft_sensor"];
+
+/// A model with its configured frames and standing posture.
+#[derive(Debug, Clone)]
+pub struct Robot {
+    /// Robot name from the config.
+    pub name: String,
+    /// The kinematic model, with the end-effector and FT sensor frames added.
+    pub model: Model,
+    /// The link the config calls the floating base (for base orientation tasks).
+    pub base_link: LinkId,
+    /// End-effector frames, indexed by `EndEffector as usize`.
+    pub end_effectors: [FrameId; 4],
+    /// Sole contact rectangle (both feet).
+    pub sole: SoleRectangle,
+    /// FT sensor frames: left foot, right foot.
+    pub ft_sensors: [FrameId; 2],
+    /// Joint groups.
+    pub joint_groups: JointGroups,
+    /// Standing posture: both soles flat on z = 0, their midpoint at x = y = 0.
+    pub standing: Configuration,
+}
+
+/// Why a robot config cannot be loaded; each variant names the file and key.
+#[derive(Debug, thiserror::Error)]
+pub enum RobotError {
+    /// The config file could not be read.
+    #[error("cannot read robot config {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The TOML does not parse or the `[robot]` section does not match the schema.
+    #[error("{path}: invalid [robot] section: {message}")]
+    Schema {
+        /// The file.
+        path: PathBuf,
+        /// The parser's message (names the key, line and column).
+        message: String,
+    },
+    /// Neither the config nor the caller gives a URDF.
+    #[error(
+        "{path}: robot '{robot}' has no `urdf` key in [robot] (its model is not distributed with \
+         this project); pass the model with `--urdf PATH` or set `urdf` in the config"
+    )]
+    MissingUrdf {
+        /// The config file.
+        path: PathBuf,
+        /// The robot name.
+        robot: String,
+    },
+    /// The URDF is invalid.
+    #[error("{urdf}: {source}")]
+    Model {
+        /// The URDF file.
+        urdf: PathBuf,
+        /// What is wrong with it.
+        source: ModelError,
+    },
+    /// A key names a link the model does not have.
+    #[error("{path}: robot.{key}: link '{name}' is not in the model")]
+    UnknownLink {
+        /// The config file.
+        path: PathBuf,
+        /// The key.
+        key: String,
+        /// The missing link.
+        name: String,
+    },
+    /// A key names a joint the model does not have (or a fixed/mimic joint).
+    #[error("{path}: robot.{key}: joint '{name}' is not an actuated joint of the model")]
+    UnknownJoint {
+        /// The config file.
+        path: PathBuf,
+        /// The key.
+        key: String,
+        /// The missing joint.
+        name: String,
+    },
+    /// A value is out of range.
+    #[error("{path}: robot.{key}: {message}")]
+    Invalid {
+        /// The config file.
+        path: PathBuf,
+        /// The key.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// A frame declared in the config: link + pose in the link frame.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrameSpec {
+    link: String,
+    #[serde(default)]
+    translation: [f64; 3],
+    #[serde(default)]
+    rpy: [f64; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EndEffectorSpecs {
+    left_foot: FrameSpec,
+    right_foot: FrameSpec,
+    left_hand: FrameSpec,
+    right_hand: FrameSpec,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FtSensorSpecs {
+    left: FrameSpec,
+    right: FrameSpec,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JointGroupSpecs {
+    legs: Vec<String>,
+    arms: Vec<String>,
+    torso: Vec<String>,
+    head: Vec<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RobotSection {
+    name: String,
+    urdf: Option<PathBuf>,
+    base_link: String,
+    sole: SoleRectangle,
+    frames: EndEffectorSpecs,
+    ft_sensors: FtSensorSpecs,
+    joint_groups: JointGroupSpecs,
+    standing: BTreeMap<String, f64>,
+}
+
+/// The config file as far as this crate is concerned (other sections belong to other crates).
+#[derive(Debug, Deserialize)]
+struct ConfigFile {
+    robot: RobotSection,
+}
+
+/// Soles count as flat when their normals are within this angle (rad) of vertical and their
+/// heights agree to this distance (m).
+const FLAT_TOLERANCE: f64 = 1e-6;
+
+impl Robot {
+    /// Loads `config`'s `[robot]` section and its model (`urdf_override` wins over the config's
+    /// `urdf`; a relative config path is taken relative to the config file).
+    pub fn load(config: &Path, urdf_override: Option<&Path>) -> Result<Robot, RobotError> {
+        let text = std::fs::read_to_string(config).map_err(|source| RobotError::Io {
+            path: config.to_owned(),
+            source,
+        })?;
+        let section = toml::from_str::<ConfigFile>(&text)
+            .map_err(|error| RobotError::Schema {
+                path: config.to_owned(),
+                message: error.to_string(),
+            })?
+            .robot;
+        let urdf = match (urdf_override, &section.urdf) {
+            (Some(path), _) => path.to_owned(),
+            (None, Some(relative)) => config.parent().unwrap_or(Path::new(".")).join(relative),
+            (None, None) => {
+                return Err(RobotError::MissingUrdf {
+                    path: config.to_owned(),
+                    robot: section.name,
+                });
+            }
+        };
+        let model =
+            Model::from_urdf_path(&urdf).map_err(|source| RobotError::Model { urdf, source })?;
+        Loader {
+            path: config,
+            model,
+        }
+        .build(section)
+    }
+
+    /// The frame of an end-effector.
+    pub fn frame(&self, e: EndEffector) -> FrameId {
+        self.end_effectors[e as usize]
+    }
+}
+
+/// Resolves config names against the model, attributing errors to the config file.
+struct Loader<'a> {
+    path: &'a Path,
+    model: Model,
+}
+
+impl Loader<'_> {
+    fn build(mut self, section: RobotSection) -> Result<Robot, RobotError> {
+        let base_link = self.link("base_link", &section.base_link)?;
+        self.check_sole(&section.sole)?;
+        let frames = &section.frames;
+        let specs = [
+            &frames.left_foot,
+            &frames.right_foot,
+            &frames.left_hand,
+            &frames.right_hand,
+        ];
+        let mut end_effectors = [FrameId(0); 4];
+        for (slot, (effector, spec)) in end_effectors
+            .iter_mut()
+            .zip(EndEffector::ALL.iter().zip(specs))
+        {
+            *slot = self.frame(
+                &format!("frames.{}", effector.name()),
+                effector.name(),
+                spec,
+            )?;
+        }
+        let ft_sensors = [
+            self.frame(
+                "ft_sensors.left",
+                FT_SENSOR_FRAMES[0],
+                &section.ft_sensors.left,
+            )?,
+            self.frame(
+                "ft_sensors.right",
+                FT_SENSOR_FRAMES[1],
+                &section.ft_sensors.right,
+            )?,
+        ];
+        let groups = &section.joint_groups;
+        let joint_groups = JointGroups {
+            legs: self.joints("joint_groups.legs", &groups.legs)?,
+            arms: self.joints("joint_groups.arms", &groups.arms)?,
+            torso: self.joints("joint_groups.torso", &groups.torso)?,
+            head: self.joints("joint_groups.head", &groups.head)?,
+        };
+        let standing = self.standing(&section.standing, [end_effectors[0], end_effectors[1]])?;
+        Ok(Robot {
+            name: section.name,
+            model: self.model,
+            base_link,
+            end_effectors,
+            sole: section.sole,
+            ft_sensors,
+            joint_groups,
+            standing,
+        })
+    }
+
+    fn invalid(&self, key: &str, message: String) -> RobotError {
+        RobotError::Invalid {
+            path: self.path.to_owned(),
+            key: key.to_owned(),
+            message,
+        }
+    }
+
+    fn link(&self, key: &str, name: &str) -> Result<LinkId, RobotError> {
+        self.model
+            .link_index(name)
+            .ok_or_else(|| RobotError::UnknownLink {
+                path: self.path.to_owned(),
+                key: key.to_owned(),
+                name: name.to_owned(),
+            })
+    }
+
+    fn joint(&self, key: &str, name: &str) -> Result<usize, RobotError> {
+        self.model
+            .joint_index(name)
+            .ok_or_else(|| RobotError::UnknownJoint {
+                path: self.path.to_owned(),
+                key: key.to_owned(),
+                name: name.to_owned(),
+            })
+    }
+
+    fn joints(&self, key: &str, names: &[String]) -> Result<Vec<usize>, RobotError> {
+        names.iter().map(|name| self.joint(key, name)).collect()
+    }
+
+    fn check_sole(&self, sole: &SoleRectangle) -> Result<(), RobotError> {
+        for (key, value) in [("sole.length", sole.length), ("sole.width", sole.width)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(self.invalid(
+                    key,
+                    format!("must be a positive length in metres, got {value}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn frame(&mut self, key: &str, name: &str, spec: &FrameSpec) -> Result<FrameId, RobotError> {
+        let link = self.link(&format!("{key}.link"), &spec.link)?;
+        if !spec
+            .translation
+            .iter()
+            .chain(&spec.rpy)
+            .all(|x| x.is_finite())
+        {
+            return Err(self.invalid(key, "translation and rpy must be finite".to_owned()));
+        }
+        let offset = pose_from_xyz_rpy(spec.translation, spec.rpy);
+        self.model
+            .add_frame(name, link, offset)
+            .map_err(|error| self.invalid(key, error.to_string()))
+    }
+
+    /// The configured posture with the base placed so both soles lie flat on z = 0.
+    fn standing(
+        &self,
+        angles: &BTreeMap<String, f64>,
+        soles: [FrameId; 2],
+    ) -> Result<Configuration, RobotError> {
+        let model = &self.model;
+        let mut q = Configuration::neutral(model);
+        for (name, &angle) in angles {
+            let key = format!("standing.{name}");
+            let index = self.joint("standing", name)?;
+            let limits = model.joint_limits()[index];
+            if !(angle.is_finite() && limits.lower <= angle && angle <= limits.upper) {
+                return Err(self.invalid(
+                    &key,
+                    format!(
+                        "{angle} is outside the joint limits [{}, {}]",
+                        limits.lower, limits.upper
+                    ),
+                ));
+            }
+            q.joints[index] = angle;
+        }
+        let mut kinematics = Kinematics::new(model);
+        kinematics.update(model, &q);
+        let left = kinematics.frame_pose(model, soles[0]);
+        let right = kinematics.frame_pose(model, soles[1]);
+        // Rotate the base so the left sole is level, then split the soles' yaw difference evenly.
+        let relative = left.rotation.inverse() * right.rotation;
+        let tilt = (relative * Vector3::z()).angle(&Vector3::z());
+        if tilt > FLAT_TOLERANCE {
+            return Err(self.invalid(
+                "standing",
+                format!("the posture leaves the soles {tilt:.3e} rad apart from parallel; both must be flat"),
+            ));
+        }
+        let relative_yaw = relative.euler_angles().2;
+        let level = UnitQuaternion::from_euler_angles(0.0, 0.0, -relative_yaw / 2.0)
+            * left.rotation.inverse();
+        q.base = Isometry3::from_parts(Translation3::identity(), level);
+        kinematics.update(model, &q);
+        let left = kinematics.frame_pose(model, soles[0]).translation.vector;
+        let right = kinematics.frame_pose(model, soles[1]).translation.vector;
+        if (left.z - right.z).abs() > FLAT_TOLERANCE {
+            return Err(self.invalid(
+                "standing",
+                format!(
+                    "the posture puts the soles at different heights ({:.4} m apart)",
+                    (left.z - right.z).abs()
+                ),
+            ));
+        }
+        q.base.translation = Translation3::from(-(left + right) / 2.0);
+        Ok(q)
+    }
+}
