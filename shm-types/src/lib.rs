@@ -1,1 +1,52 @@
 //! The wire contract between `walkd`, its adapters and its clients (DESIGN.md §6).
+//!
+//! Every robot gets its own set of iceoryx2 services under a prefix (`[runtime] service_prefix`,
+//! e.g. `walk/armar4`):
+//!
+//! | service | pattern | from → to | payload |
+//! |---|---|---|---|
+//! | `sensors` | publish-subscribe + event | adapter → daemon | [`SensorSample`] |
+//! | `commands` | publish-subscribe + event | daemon → adapter | [`JointCommand`] |
+//! | `status` | publish-subscribe | daemon → clients | [`DaemonStatus`] |
+//! | `stances` | request-response | client → daemon | JSON bytes → [`SubmitReply`] |
+//! | `control` | request-response | client → daemon | [`ControlRequest`] → [`ControlReply`] |
+//!
+//! Every message type is `#[repr(C)]`, `ZeroCopySend` and carries a `#[type_name]` that contains
+//! the [`PROTOCOL_VERSION`]; a peer built against another protocol version is refused by iceoryx2
+//! when it opens a service and the port wrappers turn that into [`ShmError::ProtocolMismatch`].
+//!
+//! Processes never touch iceoryx2 directly: each role has a typed port wrapper
+//! ([`DaemonLoopPorts`] + [`DaemonServicePorts`], [`AdapterPorts`], [`ClientPorts`]) that opens the
+//! services with the one set of QoS settings defined in [`services`].
+
+mod clock;
+pub mod config;
+mod error;
+mod messages;
+pub mod ports;
+pub mod process;
+pub mod services;
+mod text;
+
+pub use ports::{AdapterPorts, ClientPorts, DaemonLoopPorts, DaemonServicePorts};
+
+pub use clock::{monotonic_ns, sleep_until};
+pub use config::{ConfigError, RuntimeConfig};
+pub use error::ShmError;
+pub use messages::{
+    ClockMode, CommandMode, ControlCommand, ControlReply, ControlRequest, DaemonState,
+    DaemonStatus, HISTOGRAM_BUCKETS, JointCommand, LatencySummary, LinkState, LogHistogram,
+    SensorSample, SubmitReply, WRENCH_ORDER,
+};
+
+pub use services::ServiceNames;
+pub use text::FixedText;
+
+/// Version of the wire protocol; part of every message's `#[type_name]`.
+pub const PROTOCOL_VERSION: u32 = 1;
+
+/// Fixed joint capacity of the joint arrays; messages carry the used count explicitly.
+pub const MAX_JOINTS: usize = 64;
+
+/// Largest post-processed sequence (JSON bytes) a client can submit.
+pub const MAX_SEQUENCE_BYTES: usize = 16 * 1024 * 1024;

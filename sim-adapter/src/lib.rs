@@ -1,1 +1,19 @@
 //! `walk-sim`: simulated robots behind the adapter side of the IPC contract.
+//!
+//! - [`RobotIo`]: what an adapter needs from a robot — read its sensors, write joint setpoints.
+//!   A hardware adapter (ARMAR-4, HRP-4) implements only this (see docs/adapter.md).
+//! - [`run_adapter`]: the adapter loop shared by every robot: publishes samples through
+//!   [`shm_types::AdapterPorts`], applies commands, and holds position when commands go stale.
+//! - [`KinematicRobot`]: [`RobotIo`] over the kinematic simulator (`--physics kinematic`).
+
+mod adapter_loop;
+mod kinematic;
+mod robot_io;
+
+/// The MuJoCo physics backend (feature `mujoco`; library from scripts/setup-mujoco.sh).
+#[cfg(feature = "mujoco")]
+pub mod mujoco;
+
+pub use adapter_loop::{AdapterError, AdapterOptions, AdapterReport, run_adapter};
+pub use kinematic::KinematicRobot;
+pub use robot_io::RobotIo;

@@ -1,1 +1,121 @@
-fn main() {}
+//! `walk-sim`: a simulated robot process behind the adapter side of the walkd IPC contract.
+//!
+//! ```text
+//! walk-sim --config configs/armar4.toml --physics kinematic [--clock realtime|lockstep]
+//!          [--rate-hz F] [--urdf PATH] [--service-prefix P]
+//! ```
+//! Exit codes: see `shm_types::process::exit_code` (0 clean, 3 config/model, 4 IPC, 1 other).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::Duration;
+
+use clap::{Parser, ValueEnum};
+use kinematics::robot::Robot;
+use shm_types::process::{exit_code, install_termination_handler, termination_requested};
+use shm_types::{AdapterPorts, ClockMode, RuntimeConfig, ServiceNames};
+use sim_adapter::{AdapterOptions, KinematicRobot, run_adapter};
+
+/// Simulated robot for walkd: publishes sensor samples, applies joint commands.
+#[derive(Parser)]
+#[command(name = "walk-sim", version, about)]
+struct Args {
+    /// Robot config (its [robot] and [runtime] sections are used).
+    #[arg(long)]
+    config: PathBuf,
+    /// URDF to use instead of the one named in the config.
+    #[arg(long)]
+    urdf: Option<PathBuf>,
+    /// Simulator backend.
+    #[arg(long, value_enum)]
+    physics: Physics,
+    /// realtime: a sample every period; lockstep: the next sample once the previous is answered.
+    #[arg(long, default_value = "realtime")]
+    clock: ClockMode,
+    /// Sample rate, overriding `[runtime] rate_hz`.
+    #[arg(long)]
+    rate_hz: Option<f64>,
+    /// Service prefix, overriding `[runtime] service_prefix`.
+    #[arg(long)]
+    service_prefix: Option<String>,
+}
+
+/// The simulator backends.
+#[derive(Clone, Copy, ValueEnum)]
+enum Physics {
+    /// Deterministic kinematic simulator (ideal servos, feet anchored in contact).
+    Kinematic,
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_writer(std::io::stderr)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .init();
+    let args = Args::parse();
+    match run(&args) {
+        Ok(()) => ExitCode::from(exit_code::OK),
+        Err((code, error)) => {
+            tracing::error!("{error:#}");
+            ExitCode::from(code)
+        }
+    }
+}
+
+fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
+    let config_error = |e: anyhow::Error| (exit_code::CONFIG, e);
+    let mut runtime =
+        RuntimeConfig::from_config_file(&args.config).map_err(|e| config_error(e.into()))?;
+    if let Some(rate) = args.rate_hz {
+        runtime.rate_hz = rate;
+    }
+    if let Some(prefix) = &args.service_prefix {
+        runtime.service_prefix.clone_from(prefix);
+    }
+    if !(runtime.rate_hz.is_finite() && runtime.rate_hz > 0.0) {
+        return Err(config_error(anyhow::anyhow!(
+            "--rate-hz {} must be positive",
+            runtime.rate_hz
+        )));
+    }
+    let robot =
+        Robot::load(&args.config, args.urdf.as_deref()).map_err(|e| config_error(e.into()))?;
+    let mut sim = match args.physics {
+        Physics::Kinematic => KinematicRobot::standing(Arc::new(robot))
+            .map_err(|e| config_error(anyhow::Error::from(e).context("standing posture")))?,
+    };
+    let names =
+        ServiceNames::new(&runtime.service_prefix).map_err(|e| (exit_code::IPC, e.into()))?;
+    let ports = AdapterPorts::open(&names, "walk-sim").map_err(|e| (exit_code::IPC, e.into()))?;
+    install_termination_handler();
+    let options = AdapterOptions {
+        clock: args.clock,
+        rate_hz: runtime.rate_hz,
+        watchdog_periods: runtime.watchdog_periods,
+        lockstep_timeout: Duration::from_millis(runtime.lockstep_timeout_ms),
+    };
+    tracing::info!(
+        prefix = names.prefix(),
+        clock = args.clock.name(),
+        rate_hz = runtime.rate_hz,
+        "walk-sim running"
+    );
+    let report = run_adapter(&ports, &mut sim, &options, &termination_requested)
+        .map_err(|e| (exit_code::IPC, e.into()))?;
+    let safety = sim.summary();
+    tracing::info!(
+        samples = report.samples,
+        commands = report.commands,
+        watchdog_trips = report.watchdog_trips,
+        overruns = report.overruns,
+        fell = safety.fell,
+        min_stability_margin_m = safety.min_stability_margin,
+        "walk-sim stopped"
+    );
+    Ok(())
+}

@@ -1,0 +1,447 @@
+//! The control thread: waits for samples, ticks the controller, sends commands.
+//!
+//! Realtime clock: the loop runs on a grid of absolute periods (`clock_nanosleep` on
+//! CLOCK_MONOTONIC) aligned so that the adapter's samples, by their timestamps, fall mid-period.
+//! Each period it sleeps until the period starts (never ticking early, so it never bursts),
+//! waits for a sample stamped in this period until the period ends, ticks and sends the
+//! command. Deadline accounting:
+//! - a command sent after the end of its sample's period is a deadline miss, and so is every
+//!   period the overrun swallowed; the grid then continues with the first period that has not
+//!   ended (no catching up);
+//! - a period without a sample of its own is stale (an older sample is dropped unanswered, a
+//!   sample stamped in a later period is answered in that period); `watchdog_periods` stale
+//!   periods in a row trip the watchdog: the controller holds, a hold command goes out and the
+//!   status reports the stale link; the grid re-aligns on the next sample, and also whenever the
+//!   adapter's phase moves by more than a quarter period.
+//!
+//! Lockstep clock: one tick per received sample, no sleeping; the watchdog trips after
+//! `lockstep_timeout` of wall time without a sample.
+//!
+//! After start-up nothing here allocates, frees, locks or logs per tick.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use nalgebra::{Quaternion, UnitQuaternion};
+use shm_types::{
+    ClockMode, ControlCommand, DaemonLoopPorts, DaemonState, DaemonStatus, FixedText, LinkState,
+    SensorSample, ShmError, monotonic_ns, sleep_until,
+};
+
+use super::shared::{Shared, StartOutcome};
+use super::snapshot::SnapshotWriter;
+use super::stats::{LoopStats, log_histogram, record, summarize};
+use crate::controller::{
+    Command, CommandMode, Controller, ControllerState, FaultCode, Measurement, PreparedSequence,
+};
+
+/// Longest single blocking wait, so stop requests and submissions are seen quickly.
+const MAX_WAIT: Duration = Duration::from_millis(20);
+
+/// Timing of the control loop.
+#[derive(Debug, Clone, Copy)]
+pub struct LoopTiming {
+    /// Realtime or lockstep.
+    pub clock: ClockMode,
+    /// Control period (also the controller's `dt` in both modes).
+    pub period_ns: u64,
+    /// Realtime: stale periods in a row that trip the watchdog.
+    pub watchdog_periods: u32,
+    /// Lockstep: wall time without a sample that trips the watchdog.
+    pub lockstep_timeout_ns: u64,
+    /// Interval between status snapshots.
+    pub status_interval_ns: u64,
+}
+
+/// The control thread's state.
+pub struct ControlLoop {
+    controller: Controller,
+    ports: DaemonLoopPorts,
+    shared: Arc<Shared>,
+    status_out: SnapshotWriter<DaemonStatus>,
+    timing: LoopTiming,
+    dof: usize,
+    sample: SensorSample,
+    command: Command,
+    command_seq: u64,
+    stats: LoopStats,
+    link: LinkState,
+    stale_in_row: u32,
+    sequence_id: u64,
+    last_fault: &'static str,
+    last_state: ControllerState,
+    /// A sequence to free that did not fit into the outbox yet (never freed here).
+    release_later: Option<Box<PreparedSequence>>,
+    status: DaemonStatus,
+    next_status_ns: u64,
+}
+
+impl ControlLoop {
+    /// Sets up the loop; all buffers are allocated here.
+    pub fn new(
+        controller: Controller,
+        ports: DaemonLoopPorts,
+        shared: Arc<Shared>,
+        status_out: SnapshotWriter<DaemonStatus>,
+        timing: LoopTiming,
+    ) -> Self {
+        let dof = controller.robot().model.dof();
+        let mut status = DaemonStatus::INITIAL;
+        status.pid = std::process::id();
+        status.clock = timing.clock;
+        status.rate_hz = 1e9 / timing.period_ns as f64;
+        Self {
+            controller,
+            ports,
+            shared,
+            status_out,
+            timing,
+            dof,
+            sample: SensorSample::ZERO,
+            command: Command::new(dof),
+            command_seq: 0,
+            stats: LoopStats::new(),
+            link: LinkState::Waiting,
+            stale_in_row: 0,
+            sequence_id: 0,
+            last_fault: "",
+            last_state: ControllerState::Idle,
+            release_later: None,
+            status,
+            next_status_ns: 0,
+        }
+    }
+
+    /// Runs until [`Shared::stop`] is set; then holds, sends a final hold command and writes a
+    /// final `Stopping` status.
+    pub fn run(mut self) -> Result<LoopStats, ShmError> {
+        let result = match self.timing.clock {
+            ClockMode::Realtime => self.run_realtime(),
+            ClockMode::Lockstep => self.run_lockstep(),
+        };
+        self.controller.hold();
+        if self.command_seq > 0 {
+            self.command.mode = CommandMode::Hold;
+            self.send_command()?;
+        }
+        self.write_status(DaemonState::Stopping);
+        result.map(|()| self.stats)
+    }
+
+    fn stopping(&self) -> bool {
+        self.shared.stop.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    fn run_realtime(&mut self) -> Result<(), ShmError> {
+        let period = self.timing.period_ns;
+        // `start` is the beginning of the current period; samples are expected at its middle.
+        let mut start: Option<u64> = None;
+        while !self.stopping() {
+            let Some(period_start) = start else {
+                // Not aligned (start-up or after a stale streak): tick on the first sample that
+                // comes and align the grid on the adapter's sample clock.
+                if self.wait_for_sample_until(monotonic_ns() + MAX_WAIT.as_nanos() as u64)? {
+                    self.tick(monotonic_ns())?;
+                    start = Some(self.aligned_start(monotonic_ns()));
+                } else {
+                    self.housekeeping();
+                }
+                continue;
+            };
+            sleep_until(period_start);
+            let (mut period_start, mut end) = (period_start, period_start + period);
+            let fresh = self.wait_for_current_sample(period_start, end)?;
+            let now = if fresh {
+                let stamped = self.sample.timestamp_ns;
+                if stamped >= end {
+                    // Stamped in a later period (the adapter was late, or our wait overslept):
+                    // the periods before it went without a sample; answer it in its own period.
+                    let skipped = (stamped - period_start) / period;
+                    self.stats.stale_periods += skipped;
+                    period_start += skipped * period;
+                    end += skipped * period;
+                }
+                let expected = period_start + period / 2;
+                let tick_start = monotonic_ns();
+                record(&mut self.stats.jitter, tick_start.abs_diff(expected));
+                self.tick(tick_start)?;
+                let now = monotonic_ns();
+                if now > end {
+                    // Our command is late, and every period we overran stays unanswered.
+                    self.stats.deadline_misses += 1 + (now - end) / period;
+                }
+                now
+            } else {
+                self.stale_period();
+                let now = monotonic_ns();
+                if now > end {
+                    self.stats.stale_periods += (now - end) / period;
+                }
+                now
+            };
+            // Never catch up: continue with the first period that has not ended yet.
+            let next = if now > end {
+                end + ((now - end) / period + 1) * period
+            } else {
+                end
+            };
+            let expected = period_start + period / 2;
+            start = if self.link == LinkState::Stale {
+                None
+            } else if fresh && self.sample.timestamp_ns.abs_diff(expected) > period / 4 {
+                // The adapter's phase moved (another clock, a restart): follow it.
+                Some(self.aligned_start(next))
+            } else {
+                Some(next)
+            };
+        }
+        Ok(())
+    }
+
+    /// Waits until `end` for a sample taken in this period (stamped at or after `start`). An
+    /// older one — it arrived late, or while the loop slept — is dropped unanswered, so a single
+    /// late sample cannot leave the loop answering every sample one period late.
+    fn wait_for_current_sample(&mut self, start: u64, end: u64) -> Result<bool, ShmError> {
+        while self.wait_for_sample_until(end)? {
+            if self.sample.timestamp_ns >= start {
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
+
+    /// The first period start after `not_before` that puts the adapter's samples (in phase
+    /// with the last one's timestamp) in the middle of the period.
+    fn aligned_start(&self, not_before: u64) -> u64 {
+        let period = self.timing.period_ns;
+        let phase = (self.sample.timestamp_ns + period / 2) % period;
+        let base = not_before - not_before % period + phase;
+        if base >= not_before {
+            base
+        } else {
+            base + period
+        }
+    }
+
+    fn run_lockstep(&mut self) -> Result<(), ShmError> {
+        let mut last_sample = monotonic_ns();
+        while !self.stopping() {
+            if self.wait_for_sample_until(monotonic_ns() + MAX_WAIT.as_nanos() as u64)? {
+                last_sample = monotonic_ns();
+                self.tick(last_sample)?;
+            } else {
+                self.housekeeping();
+                if monotonic_ns() - last_sample > self.timing.lockstep_timeout_ns {
+                    self.trip_watchdog();
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Waits for a fresh sample until `deadline_ns`, in short slices so a stop request, a
+    /// submission or a control command is handled meanwhile. Leaves it in `self.sample`.
+    fn wait_for_sample_until(&mut self, deadline_ns: u64) -> Result<bool, ShmError> {
+        loop {
+            if self.ports.take_latest_sample(&mut self.sample)? {
+                return Ok(true);
+            }
+            let now = monotonic_ns();
+            if now >= deadline_ns || self.stopping() {
+                return Ok(false);
+            }
+            let wait = Duration::from_nanos(deadline_ns - now).min(MAX_WAIT);
+            if !self.ports.wait_for_sample(wait)? {
+                self.housekeeping();
+            }
+        }
+    }
+
+    /// One control step on `self.sample`.
+    fn tick(&mut self, tick_start: u64) -> Result<(), ShmError> {
+        self.link = LinkState::Fresh;
+        self.stale_in_row = 0;
+        self.housekeeping();
+        let n = (self.sample.joint_count as usize).min(self.sample.q.len());
+        let imu = self.sample.has_imu.then(|| {
+            let [x, y, z, w] = self.sample.imu_orientation;
+            UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z))
+        });
+        let measurement = Measurement {
+            q: &self.sample.q[..n],
+            qd: &self.sample.qd[..n],
+            wrenches: &self.sample.wrenches,
+            imu_orientation: imu,
+        };
+        let dt = self.timing.period_ns as f64 * 1e-9;
+        self.controller.tick(&measurement, dt, &mut self.command);
+        let computed = monotonic_ns();
+        record(&mut self.stats.tick, computed - tick_start);
+        self.stats.ticks += 1;
+        self.send_command()?;
+        let sent = monotonic_ns();
+        record(
+            &mut self.stats.latency,
+            sent.saturating_sub(self.sample.timestamp_ns),
+        );
+        self.note_state_change();
+        if sent >= self.next_status_ns {
+            self.write_status(self.daemon_state());
+        }
+        Ok(())
+    }
+
+    fn send_command(&mut self) -> Result<(), ShmError> {
+        self.command_seq += 1;
+        let (seq, answers, n) = (self.command_seq, self.sample.seq, self.dof);
+        let command = &self.command;
+        self.ports.send_command(|out| {
+            out.seq = seq;
+            out.answers_seq = answers;
+            out.joint_count = n as u32;
+            out.mode = match command.mode {
+                CommandMode::Hold => shm_types::CommandMode::Hold,
+                CommandMode::Track => shm_types::CommandMode::Track,
+            };
+            out.q_des[..n].copy_from_slice(command.q_des.as_slice());
+            out.qd_des[..n].copy_from_slice(command.qd_des.as_slice());
+        })
+    }
+
+    /// Realtime: a period ended without a fresh sample.
+    fn stale_period(&mut self) {
+        self.stats.stale_periods += 1;
+        self.stale_in_row += 1;
+        if self.stale_in_row >= self.timing.watchdog_periods {
+            self.trip_watchdog();
+        }
+    }
+
+    /// No fresh sample for too long: hold and report (once per stale streak).
+    fn trip_watchdog(&mut self) {
+        if self.link == LinkState::Stale || self.link == LinkState::Waiting {
+            return;
+        }
+        self.link = LinkState::Stale;
+        self.stats.watchdog_trips += 1;
+        self.last_fault = "adapter link stale: no fresh sensor sample within the watchdog time";
+        if self.controller.status().state == ControllerState::Executing {
+            self.controller.hold();
+        }
+        // Tell the adapter to hold too, in case only its samples are lost.
+        self.command.mode = CommandMode::Hold;
+        if self.command_seq > 0 {
+            // A send failure here cannot be acted upon beyond what the status already says.
+            let _ = self.send_command();
+        }
+        self.write_status(self.daemon_state());
+    }
+
+    /// Handles control commands and submissions, and hands freed sequences out.
+    fn housekeeping(&mut self) {
+        if let Some(sequence) = self.release_later.take() {
+            self.release(sequence);
+        }
+        if let Some(command) = self.shared.take_control() {
+            match command {
+                ControlCommand::Hold => {
+                    self.controller.reset();
+                    self.controller.hold();
+                }
+                ControlCommand::Abort => {
+                    self.controller.reset();
+                    self.controller.abort();
+                }
+                ControlCommand::Query => {}
+            }
+            self.shared.control_done();
+            self.note_state_change();
+            self.write_status(self.daemon_state());
+        }
+        if let Some(submission) = self.shared.inbox.take() {
+            let outcome = if self.link != LinkState::Fresh {
+                self.release(submission.sequence);
+                StartOutcome::AdapterStale
+            } else {
+                match self.controller.start(submission.sequence) {
+                    Ok(previous) => {
+                        if let Some(previous) = previous {
+                            self.release(previous);
+                        }
+                        self.sequence_id = submission.id;
+                        StartOutcome::Started
+                    }
+                    Err(refused) => {
+                        self.release(refused);
+                        if self.controller.status().state == ControllerState::Fault {
+                            StartOutcome::Faulted
+                        } else {
+                            StartOutcome::Busy
+                        }
+                    }
+                }
+            };
+            self.shared.report_start(submission.id, outcome);
+            self.note_state_change();
+            self.write_status(self.daemon_state());
+        }
+    }
+
+    /// Hands a sequence to the service thread to free (or keeps it until the outbox is free).
+    fn release(&mut self, sequence: Box<PreparedSequence>) {
+        if let Err(sequence) = self.shared.outbox.put(sequence) {
+            self.release_later = Some(sequence);
+        }
+    }
+
+    /// Remembers the fault of a controller that just entered Fault.
+    fn note_state_change(&mut self) {
+        let status = self.controller.status();
+        if status.state != self.last_state {
+            if status.state == ControllerState::Fault && status.fault != FaultCode::None {
+                self.last_fault = status.fault.describe();
+            }
+            self.last_state = status.state;
+        }
+    }
+
+    fn daemon_state(&self) -> DaemonState {
+        match self.controller.status().state {
+            ControllerState::Idle => DaemonState::Idle,
+            ControllerState::Holding => DaemonState::Holding,
+            ControllerState::Executing => DaemonState::Executing,
+            ControllerState::Done => DaemonState::Done,
+            ControllerState::Fault => DaemonState::Fault,
+        }
+    }
+
+    /// Writes a status snapshot for the service thread. No allocation.
+    fn write_status(&mut self, state: DaemonState) {
+        let controller = self.controller.status();
+        let status = &mut self.status;
+        status.timestamp_ns = monotonic_ns();
+        status.state = state;
+        status.sequence_id = self.sequence_id;
+        status.stance_index = controller.stance_index;
+        status.stance_count = controller.stance_count;
+        status.phase = FixedText::new(controller.phase.name());
+        status.com = controller.com;
+        status.left_foot = controller.left_foot;
+        status.right_foot = controller.right_foot;
+        status.fault = FixedText::new(self.last_fault);
+        status.link = self.link;
+        status.adapter_holding = self.sample.adapter_holding;
+        status.ticks = self.stats.ticks;
+        status.deadline_misses = self.stats.deadline_misses;
+        status.stale_periods = self.stats.stale_periods;
+        status.watchdog_trips = self.stats.watchdog_trips;
+        status.tick_us = summarize(&self.stats.tick);
+        status.latency_us = summarize(&self.stats.latency);
+        status.jitter_us = summarize(&self.stats.jitter);
+        status.tick_histogram = log_histogram(&self.stats.tick);
+        status.latency_histogram = log_histogram(&self.stats.latency);
+        status.jitter_histogram = log_histogram(&self.stats.jitter);
+        self.status_out.write(&self.status);
+        self.next_status_ns = self.status.timestamp_ns + self.timing.status_interval_ns;
+    }
+}

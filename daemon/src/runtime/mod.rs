@@ -1,0 +1,258 @@
+//! The daemon process: `walkd --config CONFIG [--urdf PATH] [--rate-hz F] [--clock realtime|lockstep]`.
+//!
+//! Threads:
+//! - the **control thread** ([`control_loop`]) waits for sensor samples, ticks the controller at a
+//!   fixed rate (or once per sample in lockstep) and sends joint commands; it allocates, frees,
+//!   locks and logs nothing per tick;
+//! - the **main thread** ([`service`]) serves sequence submissions and control requests, publishes
+//!   the status at `[runtime] status_rate_hz`, and talks to systemd.
+//!
+//! They share only lock-free slots and atomics ([`shared`], [`handoff`], [`snapshot`]).
+//!
+//! Signals: SIGTERM / SIGINT → the controller holds, a final hold command and a final `stopping`
+//! status go out, services are released, exit 0.
+//!
+//! Exit codes ([`shm_types::process::exit_code`]): 0 clean shutdown, 1 runtime failure,
+//! 2 bad command line, 3 config or model error, 4 IPC error (e.g. a peer of another protocol
+//! version), 5 controller could not be built.
+
+mod control_loop;
+mod handoff;
+mod realtime;
+mod service;
+mod shared;
+mod snapshot;
+mod stats;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
+
+use kinematics::robot::Robot;
+use shm_types::process::{exit_code, install_termination_handler, termination_requested};
+use shm_types::{
+    ClockMode, DaemonLoopPorts, DaemonServicePorts, DaemonStatus, RuntimeConfig, ServiceNames,
+};
+
+use crate::controller::{Controller, ControllerConfig, SolverKind};
+use control_loop::{ControlLoop, LoopTiming};
+use service::ServiceLoop;
+use shared::Shared;
+
+/// Command line of the daemon (flattened into `walkd`'s top level).
+#[derive(Debug, Clone, clap::Args)]
+pub struct DaemonArgs {
+    /// Robot config file (`[robot]`, `[controller]` and `[runtime]` are used).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// URDF overriding the one named in the config (required for HRP-4).
+    #[arg(long)]
+    pub urdf: Option<PathBuf>,
+    /// Control rate, overriding `[runtime] rate_hz`.
+    #[arg(long)]
+    pub rate_hz: Option<f64>,
+    /// realtime: fixed rate on absolute deadlines; lockstep: one tick per received sample.
+    #[arg(long, default_value = "realtime")]
+    pub clock: ClockMode,
+    /// Service prefix, overriding `[runtime] service_prefix` (e.g. to run several daemons).
+    #[arg(long)]
+    pub service_prefix: Option<String>,
+    /// SCHED_FIFO priority of the control thread, overriding `[runtime] fifo_priority`.
+    #[arg(long)]
+    pub fifo_priority: Option<i32>,
+    /// CPU to pin the control thread to, overriding `[runtime] cpu`.
+    #[arg(long)]
+    pub cpu: Option<usize>,
+    /// Skip `mlockall` even if `[runtime] lock_memory = true`.
+    #[arg(long)]
+    pub no_lock_memory: bool,
+}
+
+/// A failure with the exit code it maps to.
+struct Failure {
+    code: u8,
+    error: anyhow::Error,
+}
+
+fn fail(code: u8) -> impl FnOnce(anyhow::Error) -> Failure {
+    move |error| Failure { code, error }
+}
+
+/// Runs the daemon until SIGTERM / SIGINT; returns the documented exit code.
+pub fn main(args: &DaemonArgs) -> ExitCode {
+    let (writer, _log_guard) = tracing_appender::non_blocking(std::io::stderr());
+    tracing_subscriber::fmt()
+        .with_writer(writer)
+        .with_ansi(false)
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .init();
+    match run(args) {
+        Ok(()) => ExitCode::from(exit_code::OK),
+        Err(Failure { code, error }) => {
+            tracing::error!("{error:#}");
+            ExitCode::from(code)
+        }
+    }
+}
+
+/// Everything loaded from the config before any thread starts.
+struct Setup {
+    runtime: RuntimeConfig,
+    robot: Arc<Robot>,
+    controller_config: ControllerConfig,
+}
+
+fn load(args: &DaemonArgs) -> Result<Setup, Failure> {
+    let config = args.config.as_deref().ok_or_else(|| {
+        fail(exit_code::USAGE)(anyhow::anyhow!(
+            "--config CONFIG is required to run the daemon"
+        ))
+    })?;
+    let mut runtime =
+        RuntimeConfig::from_config_file(config).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
+    if let Some(rate) = args.rate_hz {
+        if !(rate.is_finite() && rate > 0.0) {
+            return Err(fail(exit_code::USAGE)(anyhow::anyhow!(
+                "--rate-hz {rate} must be positive"
+            )));
+        }
+        runtime.rate_hz = rate;
+    }
+    if let Some(prefix) = &args.service_prefix {
+        runtime.service_prefix.clone_from(prefix);
+    }
+    if args.fifo_priority.is_some() {
+        runtime.fifo_priority = args.fifo_priority;
+    }
+    if args.cpu.is_some() {
+        runtime.cpu = args.cpu;
+    }
+    runtime.lock_memory &= !args.no_lock_memory;
+    let robot =
+        Robot::load(config, args.urdf.as_deref()).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
+    let controller_config = ControllerConfig::from_config_file(config)
+        .map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
+    Ok(Setup {
+        runtime,
+        robot: Arc::new(robot),
+        controller_config,
+    })
+}
+
+fn run(args: &DaemonArgs) -> Result<(), Failure> {
+    let Setup {
+        runtime,
+        robot,
+        controller_config,
+    } = load(args)?;
+    let controller = Controller::new(Arc::clone(&robot), controller_config, SolverKind::Dense)
+        .map_err(|e| fail(exit_code::CONTROLLER)(e.into()))?;
+    let names = ServiceNames::new(&runtime.service_prefix)
+        .map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
+    install_termination_handler();
+    if runtime.lock_memory {
+        realtime::lock_memory();
+    }
+    let ports =
+        DaemonServicePorts::open(&names, "walkd").map_err(|e| fail(exit_code::IPC)(e.into()))?;
+    if ports.cleaned_dead_nodes() > 0 {
+        tracing::warn!(
+            nodes = ports.cleaned_dead_nodes(),
+            "removed stale iceoryx2 resources of dead processes (e.g. a killed walkd)"
+        );
+    }
+    let shared = Arc::new(Shared::new());
+    let (status_out, status_in) = snapshot::snapshot(DaemonStatus::INITIAL);
+    let timing = LoopTiming {
+        clock: args.clock,
+        period_ns: (1e9 / runtime.rate_hz) as u64,
+        watchdog_periods: runtime.watchdog_periods,
+        lockstep_timeout_ns: runtime.lockstep_timeout_ms * 1_000_000,
+        status_interval_ns: (1e9 / runtime.status_rate_hz) as u64,
+    };
+    let control_thread =
+        spawn_control_thread(&names, &runtime, controller, &shared, status_out, timing)?;
+    let mut service = ServiceLoop::new(
+        ports,
+        Arc::clone(&shared),
+        status_in,
+        robot,
+        controller_config,
+        runtime.status_rate_hz,
+    );
+    let _ = sd_notify::notify(&[sd_notify::NotifyState::Ready]);
+    tracing::info!(
+        prefix = names.prefix(),
+        clock = args.clock.name(),
+        rate_hz = runtime.rate_hz,
+        "walkd ready"
+    );
+    let served = service.run(|| !termination_requested() && !control_thread.is_finished());
+    let _ = sd_notify::notify(&[sd_notify::NotifyState::Stopping]);
+    shared.stop.store(true, Ordering::Relaxed);
+    let stats = control_thread
+        .join()
+        .map_err(|_| fail(exit_code::FAILURE)(anyhow::anyhow!("the control thread panicked")))?;
+    // The control thread wrote its final `stopping` status; publish it before releasing services.
+    service
+        .publish_status()
+        .map_err(|e| fail(exit_code::IPC)(e.into()))?;
+    served.map_err(|e| fail(exit_code::IPC)(e.into()))?;
+    let stats = stats.map_err(|e| fail(exit_code::IPC)(e.into()))?;
+    tracing::info!(
+        ticks = stats.ticks,
+        deadline_misses = stats.deadline_misses,
+        stale_periods = stats.stale_periods,
+        watchdog_trips = stats.watchdog_trips,
+        "walkd stopped"
+    );
+    Ok(())
+}
+
+/// Starts the control thread; returns once its ports are open (or failed to open).
+fn spawn_control_thread(
+    names: &ServiceNames,
+    runtime: &RuntimeConfig,
+    controller: Controller,
+    shared: &Arc<Shared>,
+    status_out: snapshot::SnapshotWriter<DaemonStatus>,
+    timing: LoopTiming,
+) -> Result<std::thread::JoinHandle<Result<stats::LoopStats, shm_types::ShmError>>, Failure> {
+    let (ready_tx, ready_rx) = std::sync::mpsc::channel();
+    let names = names.clone();
+    let shared = Arc::clone(shared);
+    let (priority, cpu) = (runtime.fifo_priority, runtime.cpu);
+    let thread = std::thread::Builder::new()
+        .name("walkd-control".to_owned())
+        .spawn(move || {
+            if let Some(cpu) = cpu {
+                realtime::pin_to_cpu(cpu);
+            }
+            if let Some(priority) = priority {
+                realtime::set_fifo_priority(priority);
+            }
+            let ports = match DaemonLoopPorts::open(&names, "walkd-control") {
+                Ok(ports) => {
+                    let _ = ready_tx.send(Ok(()));
+                    ports
+                }
+                Err(error) => {
+                    let _ = ready_tx.send(Err(error));
+                    return Ok(stats::LoopStats::new());
+                }
+            };
+            ControlLoop::new(controller, ports, shared, status_out, timing).run()
+        })
+        .map_err(|e| fail(exit_code::FAILURE)(e.into()))?;
+    match ready_rx.recv() {
+        Ok(Ok(())) => Ok(thread),
+        Ok(Err(error)) => Err(fail(exit_code::IPC)(error.into())),
+        Err(_) => Err(fail(exit_code::FAILURE)(anyhow::anyhow!(
+            "the control thread died at start"
+        ))),
+    }
+}

@@ -1,0 +1,57 @@
+//! Real-time process and thread settings; each degrades to a warning when not permitted.
+
+/// Locks all current and future memory so page faults cannot stall the control loop.
+pub fn lock_memory() {
+    // SAFETY: mlockall has no memory-safety preconditions.
+    if unsafe { libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) } != 0 {
+        tracing::warn!(
+            error = %std::io::Error::last_os_error(),
+            "mlockall not permitted: memory stays pageable (raise RLIMIT_MEMLOCK or grant CAP_IPC_LOCK)"
+        );
+    } else {
+        tracing::info!("memory locked (mlockall)");
+    }
+}
+
+/// Gives the calling thread SCHED_FIFO at `priority`.
+pub fn set_fifo_priority(priority: i32) {
+    let param = libc::sched_param {
+        sched_priority: priority,
+    };
+    // SAFETY: `param` is a valid sched_param for the calling thread.
+    let result =
+        unsafe { libc::pthread_setschedparam(libc::pthread_self(), libc::SCHED_FIFO, &param) };
+    if result != 0 {
+        tracing::warn!(
+            priority,
+            error = %std::io::Error::from_raw_os_error(result),
+            "SCHED_FIFO not permitted: the control thread keeps normal scheduling (grant CAP_SYS_NICE or an RLIMIT_RTPRIO)"
+        );
+    } else {
+        tracing::info!(priority, "control thread runs SCHED_FIFO");
+    }
+}
+
+/// Pins the calling thread to `cpu`.
+pub fn pin_to_cpu(cpu: usize) {
+    // SAFETY: a zeroed cpu_set_t is a valid empty set; CPU_SET stays inside it for cpu <
+    // CPU_SETSIZE, which is checked first.
+    let result = unsafe {
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        if cpu >= libc::CPU_SETSIZE as usize {
+            -1
+        } else {
+            libc::CPU_SET(cpu, &mut set);
+            libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set)
+        }
+    };
+    if result != 0 {
+        tracing::warn!(
+            cpu,
+            error = %std::io::Error::last_os_error(),
+            "CPU affinity not applied: the control thread may migrate between CPUs"
+        );
+    } else {
+        tracing::info!(cpu, "control thread pinned");
+    }
+}

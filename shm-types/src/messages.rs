@@ -1,0 +1,512 @@
+//! The message types carried by the services (see the crate docs for who sends what).
+//!
+//! All are `#[repr(C)]`, `ZeroCopySend` and named `walk.v<PROTOCOL_VERSION>.<Type>` so a peer of
+//! another protocol version cannot open the same service by accident.
+
+use iceoryx2::prelude::ZeroCopySend;
+
+use crate::{FixedText, MAX_JOINTS};
+
+/// Wrench order in [`SensorSample::wrenches`]: left foot, right foot, left hand, right hand.
+pub const WRENCH_ORDER: [&str; 4] = ["left_foot", "right_foot", "left_hand", "right_hand"];
+
+/// One sensor reading, adapter → daemon.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[type_name("walk.v1.SensorSample")]
+pub struct SensorSample {
+    /// Strictly increasing per adapter run.
+    pub seq: u64,
+    /// When the reading was taken, [`crate::monotonic_ns`].
+    pub timestamp_ns: u64,
+    /// Used entries of `q` and `qd`, in the model's joint order.
+    pub joint_count: u32,
+    /// Whether `imu_orientation` holds a reading.
+    pub has_imu: bool,
+    /// Whether the adapter currently holds position on its own (its command watchdog tripped).
+    pub adapter_holding: bool,
+    /// Joint angles (rad or m).
+    pub q: [f64; MAX_JOINTS],
+    /// Joint velocities.
+    pub qd: [f64; MAX_JOINTS],
+    /// Four 6-axis wrenches (force xyz, torque xyz) in [`WRENCH_ORDER`], world-aligned axes at
+    /// the sensor frame origin.
+    pub wrenches: [[f64; 6]; 4],
+    /// Base orientation quaternion (x, y, z, w) when `has_imu`.
+    pub imu_orientation: [f64; 4],
+}
+
+/// What the adapter shall do with a [`JointCommand`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[type_name("walk.v1.CommandMode")]
+pub enum CommandMode {
+    /// Keep the posture in `q_des` (velocities are zero).
+    Hold,
+    /// Track `q_des` / `qd_des`.
+    Track,
+}
+
+/// One joint command, daemon → adapter.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[type_name("walk.v1.JointCommand")]
+pub struct JointCommand {
+    /// Strictly increasing per daemon run.
+    pub seq: u64,
+    /// `seq` of the [`SensorSample`] this command answers.
+    pub answers_seq: u64,
+    /// When the command was sent, [`crate::monotonic_ns`].
+    pub timestamp_ns: u64,
+    /// Used entries of `q_des` and `qd_des`.
+    pub joint_count: u32,
+    /// Hold or track.
+    pub mode: CommandMode,
+    /// Desired joint positions.
+    pub q_des: [f64; MAX_JOINTS],
+    /// Desired joint velocities.
+    pub qd_des: [f64; MAX_JOINTS],
+}
+
+impl SensorSample {
+    /// An all-zero sample (no joints, no IMU).
+    pub const ZERO: Self = Self {
+        seq: 0,
+        timestamp_ns: 0,
+        joint_count: 0,
+        has_imu: false,
+        adapter_holding: false,
+        q: [0.0; MAX_JOINTS],
+        qd: [0.0; MAX_JOINTS],
+        wrenches: [[0.0; 6]; 4],
+        imu_orientation: [0.0, 0.0, 0.0, 1.0],
+    };
+
+    /// The used joint angles.
+    pub fn q(&self) -> &[f64] {
+        &self.q[..joint_len(self.joint_count)]
+    }
+
+    /// The used joint velocities.
+    pub fn qd(&self) -> &[f64] {
+        &self.qd[..joint_len(self.joint_count)]
+    }
+}
+
+impl Default for SensorSample {
+    fn default() -> Self {
+        Self::ZERO
+    }
+}
+
+impl JointCommand {
+    /// An all-zero hold command.
+    pub const ZERO: Self = Self {
+        seq: 0,
+        answers_seq: 0,
+        timestamp_ns: 0,
+        joint_count: 0,
+        mode: CommandMode::Hold,
+        q_des: [0.0; MAX_JOINTS],
+        qd_des: [0.0; MAX_JOINTS],
+    };
+
+    /// The used desired joint positions.
+    pub fn q_des(&self) -> &[f64] {
+        &self.q_des[..joint_len(self.joint_count)]
+    }
+
+    /// The used desired joint velocities.
+    pub fn qd_des(&self) -> &[f64] {
+        &self.qd_des[..joint_len(self.joint_count)]
+    }
+}
+
+impl Default for JointCommand {
+    fn default() -> Self {
+        Self::ZERO
+    }
+}
+
+/// A received joint count clamped to the capacity, so a corrupt count cannot index out of bounds.
+fn joint_len(count: u32) -> usize {
+    (count as usize).min(MAX_JOINTS)
+}
+
+/// The daemon's state as clients see it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[type_name("walk.v1.DaemonState")]
+pub enum DaemonState {
+    /// Up, no sequence run yet.
+    Idle,
+    /// Holding the current posture (after hold, abort, a watchdog trip or a finished hold).
+    Holding,
+    /// Executing a sequence.
+    Executing,
+    /// The last sequence completed.
+    Done,
+    /// The controller faulted; `DaemonStatus::fault` says why.
+    Fault,
+    /// Shutting down (the last status before the daemon exits).
+    Stopping,
+}
+
+impl DaemonState {
+    /// Lower-case name for printing and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Idle => "idle",
+            Self::Holding => "holding",
+            Self::Executing => "executing",
+            Self::Done => "done",
+            Self::Fault => "fault",
+            Self::Stopping => "stopping",
+        }
+    }
+}
+
+/// How the daemon's control loop is clocked.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[type_name("walk.v1.ClockMode")]
+pub enum ClockMode {
+    /// Fixed rate on absolute deadlines of `CLOCK_MONOTONIC`.
+    Realtime,
+    /// One tick per received sample; the simulator drives time.
+    Lockstep,
+}
+
+impl ClockMode {
+    /// Lower-case name, as accepted by `--clock`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Realtime => "realtime",
+            Self::Lockstep => "lockstep",
+        }
+    }
+}
+
+impl core::str::FromStr for ClockMode {
+    type Err = String;
+
+    /// Parses `realtime` or `lockstep` (the `--clock` option of walkd and the adapters).
+    fn from_str(text: &str) -> Result<Self, String> {
+        match text {
+            "realtime" => Ok(Self::Realtime),
+            "lockstep" => Ok(Self::Lockstep),
+            other => Err(format!(
+                "unknown clock `{other}` (expected realtime or lockstep)"
+            )),
+        }
+    }
+}
+
+/// Health of the link to the adapter as the daemon's watchdog sees it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[type_name("walk.v1.LinkState")]
+pub enum LinkState {
+    /// No sample received yet.
+    Waiting,
+    /// Samples arrive in time.
+    Fresh,
+    /// The watchdog tripped: no fresh sample for the configured number of periods.
+    Stale,
+}
+
+impl LinkState {
+    /// Lower-case name for printing and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Waiting => "waiting",
+            Self::Fresh => "fresh",
+            Self::Stale => "stale",
+        }
+    }
+}
+
+/// Percentiles of a latency distribution in microseconds.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[type_name("walk.v1.LatencySummary")]
+pub struct LatencySummary {
+    /// Median.
+    pub p50: f32,
+    /// 99th percentile.
+    pub p99: f32,
+    /// Maximum.
+    pub max: f32,
+}
+
+/// Number of buckets of a [`LogHistogram`].
+pub const HISTOGRAM_BUCKETS: usize = 20;
+
+/// A coarse histogram of durations: bucket 0 counts [0, 2) µs, bucket `b` counts
+/// [2^b, 2^(b+1)) µs, the last bucket everything above.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[type_name("walk.v1.LogHistogram")]
+pub struct LogHistogram {
+    /// Samples per bucket.
+    pub counts: [u64; HISTOGRAM_BUCKETS],
+}
+
+impl LogHistogram {
+    /// Lower bound of bucket `b` in µs.
+    pub fn bucket_floor_us(b: usize) -> u64 {
+        if b == 0 { 0 } else { 1 << b }
+    }
+}
+
+/// The daemon's state, published at a low rate (daemon → clients) and returned by `control`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[type_name("walk.v1.DaemonStatus")]
+pub struct DaemonStatus {
+    /// [`crate::PROTOCOL_VERSION`] of the daemon.
+    pub protocol_version: u32,
+    /// Process id of the daemon.
+    pub pid: u32,
+    /// When this status was assembled, [`crate::monotonic_ns`].
+    pub timestamp_ns: u64,
+    /// Controller state.
+    pub state: DaemonState,
+    /// Clock mode of the control loop.
+    pub clock: ClockMode,
+    /// Control rate.
+    pub rate_hz: f64,
+    /// Id of the sequence executing or last executed (0: none yet).
+    pub sequence_id: u64,
+    /// Index of the current stance within the sequence.
+    pub stance_index: u32,
+    /// Stances in the sequence.
+    pub stance_count: u32,
+    /// Name of the current phase of the stance transition.
+    pub phase: FixedText<32>,
+    /// Centre of mass in world frame (m).
+    pub com: [f64; 3],
+    /// Left sole pose: translation xyz + quaternion xyzw.
+    pub left_foot: [f64; 7],
+    /// Right sole pose: translation xyz + quaternion xyzw.
+    pub right_foot: [f64; 7],
+    /// Last fault (empty: none).
+    pub fault: FixedText<160>,
+    /// Adapter link as seen by the watchdog.
+    pub link: LinkState,
+    /// Whether the adapter reports holding on its own.
+    pub adapter_holding: bool,
+    /// Control ticks executed.
+    pub ticks: u64,
+    /// Periods whose command went out after the period's deadline (realtime clock only).
+    pub deadline_misses: u64,
+    /// Periods that ended without a fresh sample.
+    pub stale_periods: u64,
+    /// Times the sample watchdog tripped.
+    pub watchdog_trips: u64,
+    /// Compute time of `Controller::tick`.
+    pub tick_us: LatencySummary,
+    /// Sample timestamp → command sent.
+    pub latency_us: LatencySummary,
+    /// |tick start − its grid time| (realtime clock only).
+    pub jitter_us: LatencySummary,
+    /// Distribution of `tick_us`.
+    pub tick_histogram: LogHistogram,
+    /// Distribution of `latency_us`.
+    pub latency_histogram: LogHistogram,
+    /// Distribution of `jitter_us`.
+    pub jitter_histogram: LogHistogram,
+}
+
+impl DaemonStatus {
+    /// The status of a daemon that has not ticked yet.
+    pub const INITIAL: Self = Self {
+        protocol_version: crate::PROTOCOL_VERSION,
+        pid: 0,
+        timestamp_ns: 0,
+        state: DaemonState::Idle,
+        clock: ClockMode::Realtime,
+        rate_hz: 0.0,
+        sequence_id: 0,
+        stance_index: 0,
+        stance_count: 0,
+        phase: FixedText::EMPTY,
+        com: [0.0; 3],
+        left_foot: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+        right_foot: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+        fault: FixedText::EMPTY,
+        link: LinkState::Waiting,
+        adapter_holding: false,
+        ticks: 0,
+        deadline_misses: 0,
+        stale_periods: 0,
+        watchdog_trips: 0,
+        tick_us: LatencySummary {
+            p50: 0.0,
+            p99: 0.0,
+            max: 0.0,
+        },
+        latency_us: LatencySummary {
+            p50: 0.0,
+            p99: 0.0,
+            max: 0.0,
+        },
+        jitter_us: LatencySummary {
+            p50: 0.0,
+            p99: 0.0,
+            max: 0.0,
+        },
+        tick_histogram: LogHistogram {
+            counts: [0; HISTOGRAM_BUCKETS],
+        },
+        latency_histogram: LogHistogram {
+            counts: [0; HISTOGRAM_BUCKETS],
+        },
+        jitter_histogram: LogHistogram {
+            counts: [0; HISTOGRAM_BUCKETS],
+        },
+    };
+}
+
+impl Default for DaemonStatus {
+    fn default() -> Self {
+        Self::INITIAL
+    }
+}
+
+/// The daemon's answer to a submitted sequence.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[type_name("walk.v1.SubmitReply")]
+pub struct SubmitReply {
+    /// Whether the sequence was validated, prepared and started.
+    pub accepted: bool,
+    /// Id given to an accepted sequence (0 when refused).
+    pub sequence_id: u64,
+    /// Why it was refused (empty when accepted).
+    pub reason: FixedText<512>,
+}
+
+impl SubmitReply {
+    /// An acceptance with the sequence's id.
+    pub fn accepted(sequence_id: u64) -> Self {
+        Self {
+            accepted: true,
+            sequence_id,
+            reason: FixedText::EMPTY,
+        }
+    }
+
+    /// A refusal with its reason.
+    pub fn refused(reason: &str) -> Self {
+        Self {
+            accepted: false,
+            sequence_id: 0,
+            reason: FixedText::new(reason),
+        }
+    }
+}
+
+impl Default for SubmitReply {
+    fn default() -> Self {
+        Self::refused("")
+    }
+}
+
+/// What a client asks of the daemon on the `control` service.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[type_name("walk.v1.ControlCommand")]
+pub enum ControlCommand {
+    /// Only return the current status.
+    Query,
+    /// Stop where it is and hold the current posture.
+    Hold,
+    /// Abort the executing sequence and hold safely.
+    Abort,
+}
+
+impl ControlCommand {
+    /// Lower-case name for printing.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Query => "query",
+            Self::Hold => "hold",
+            Self::Abort => "abort",
+        }
+    }
+}
+
+/// A control request (client → daemon).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[type_name("walk.v1.ControlRequest")]
+pub struct ControlRequest {
+    /// The command.
+    pub command: ControlCommand,
+}
+
+impl Default for ControlRequest {
+    fn default() -> Self {
+        Self {
+            command: ControlCommand::Query,
+        }
+    }
+}
+
+/// The daemon's answer to a control request.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
+#[type_name("walk.v1.ControlReply")]
+pub struct ControlReply {
+    /// Whether the command was carried out.
+    pub accepted: bool,
+    /// A short explanation (why refused, or what happened).
+    pub message: FixedText<160>,
+    /// The status right after handling the command.
+    pub status: DaemonStatus,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use iceoryx2::prelude::ZeroCopySend;
+
+    /// Every type name carries the protocol version, so bumping the version changes them all.
+    #[test]
+    fn type_names_carry_the_protocol_version() {
+        let version = format!("walk.v{}.", crate::PROTOCOL_VERSION);
+        // SAFETY: type_name only returns the string given in #[type_name].
+        let names = unsafe {
+            [
+                SensorSample::type_name(),
+                JointCommand::type_name(),
+                CommandMode::type_name(),
+                DaemonStatus::type_name(),
+                DaemonState::type_name(),
+                ClockMode::type_name(),
+                LinkState::type_name(),
+                LatencySummary::type_name(),
+                LogHistogram::type_name(),
+                SubmitReply::type_name(),
+                ControlRequest::type_name(),
+                ControlCommand::type_name(),
+                ControlReply::type_name(),
+                FixedText::<8>::type_name(),
+            ]
+        };
+        for name in names {
+            assert!(name.starts_with(&version), "{name} lacks {version}");
+        }
+    }
+
+    #[test]
+    fn joint_slices_follow_the_count_and_clamp_corrupt_counts() {
+        let mut sample = SensorSample::ZERO;
+        sample.joint_count = 3;
+        sample.q[2] = 1.5;
+        assert_eq!(sample.q(), &[0.0, 0.0, 1.5]);
+        sample.joint_count = 1000;
+        assert_eq!(sample.qd().len(), MAX_JOINTS);
+    }
+}

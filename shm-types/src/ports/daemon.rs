@@ -1,0 +1,166 @@
+//! The daemon's ports: one set for the control thread, one for the service thread.
+
+use core::time::Duration;
+
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::server::Server;
+use iceoryx2::prelude::*;
+
+use super::stream::{StreamReceiver, StreamSender};
+use crate::services::{self, Access, ControlService, IpcNode, PubSub, SubmitService};
+use crate::{
+    ControlCommand, ControlReply, ControlRequest, DaemonStatus, JointCommand, SensorSample,
+    ServiceNames, ShmError, SubmitReply,
+};
+
+/// The control thread's ports: sensor samples in, joint commands out. All operations are
+/// allocation-free after `open`.
+pub struct DaemonLoopPorts {
+    sensors: StreamReceiver<SensorSample>,
+    commands: StreamSender<JointCommand>,
+    _node: IpcNode,
+}
+
+impl DaemonLoopPorts {
+    /// Opens (or creates) `sensors` and `commands` under `names`.
+    pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
+        let (node, _) = services::create_node(node_name)?;
+        let sensors = StreamReceiver::new(
+            names.full("sensors"),
+            services::sensors(&node, names)?,
+            services::sensors_event(&node, names)?,
+        )?;
+        let commands = StreamSender::new(
+            names.full("commands"),
+            services::commands(&node, names)?,
+            services::commands_event(&node, names)?,
+        )?;
+        Ok(Self {
+            sensors,
+            commands,
+            _node: node,
+        })
+    }
+
+    /// Blocks until the adapter announces a sample or `timeout` passes.
+    pub fn wait_for_sample(&self, timeout: Duration) -> Result<bool, ShmError> {
+        self.sensors.wait(timeout)
+    }
+
+    /// Copies the newest sample into `out`; false when none arrived since the last call.
+    pub fn take_latest_sample(&self, out: &mut SensorSample) -> Result<bool, ShmError> {
+        self.sensors.take_latest(out)
+    }
+
+    /// Writes a command in place, stamps its send time and wakes the adapter.
+    pub fn send_command(&self, fill: impl FnOnce(&mut JointCommand)) -> Result<(), ShmError> {
+        self.commands.send(|command| {
+            fill(command);
+            command.timestamp_ns = crate::monotonic_ns();
+        })
+    }
+}
+
+/// The service thread's ports: status out, sequence submissions and control requests in.
+pub struct DaemonServicePorts {
+    status_name: String,
+    stances_name: String,
+    control_name: String,
+    status: Publisher<ipc::Service, DaemonStatus, ()>,
+    stances: Server<ipc::Service, [u8], (), SubmitReply, ()>,
+    control: Server<ipc::Service, ControlRequest, (), ControlReply, ()>,
+    _services: (PubSub<DaemonStatus>, SubmitService, ControlService),
+    _node: IpcNode,
+    cleaned_dead_nodes: u64,
+}
+
+impl DaemonServicePorts {
+    /// Opens (or creates) `status`, `stances` and `control` under `names`.
+    pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
+        let (node, cleaned_dead_nodes) = services::create_node(node_name)?;
+        let (status_name, stances_name, control_name) = (
+            names.full("status"),
+            names.full("stances"),
+            names.full("control"),
+        );
+        let status_service = services::status(&node, names, Access::OpenOrCreate)?;
+        let stances_service = services::stances(&node, names, Access::OpenOrCreate)?;
+        let control_service = services::control(&node, names, Access::OpenOrCreate)?;
+        let status = status_service
+            .publisher_builder()
+            .create()
+            .map_err(|e| ShmError::ipc("create publisher on", &status_name, e))?;
+        let stances = stances_service
+            .server_builder()
+            .create()
+            .map_err(|e| ShmError::ipc("create server on", &stances_name, e))?;
+        let control = control_service
+            .server_builder()
+            .create()
+            .map_err(|e| ShmError::ipc("create server on", &control_name, e))?;
+        Ok(Self {
+            status_name,
+            stances_name,
+            control_name,
+            status,
+            stances,
+            control,
+            _services: (status_service, stances_service, control_service),
+            _node: node,
+            cleaned_dead_nodes,
+        })
+    }
+
+    /// How many dead nodes (of killed processes) `open` cleaned up.
+    pub fn cleaned_dead_nodes(&self) -> u64 {
+        self.cleaned_dead_nodes
+    }
+
+    /// Publishes a status snapshot.
+    pub fn publish_status(&self, status: &DaemonStatus) -> Result<(), ShmError> {
+        self.status
+            .send_copy(*status)
+            .map(|_| ())
+            .map_err(|e| ShmError::ipc("send on", &self.status_name, e))
+    }
+
+    /// Answers at most one pending submission with `handle(json_bytes)`; returns whether there
+    /// was one.
+    pub fn serve_submission(
+        &self,
+        handle: impl FnOnce(&[u8]) -> SubmitReply,
+    ) -> Result<bool, ShmError> {
+        let Some(request) = self
+            .stances
+            .receive()
+            .map_err(|e| ShmError::ipc("receive from", &self.stances_name, e))?
+        else {
+            return Ok(false);
+        };
+        let reply = handle(request.payload());
+        request
+            .send_copy(reply)
+            .map_err(|e| ShmError::ipc("reply on", &self.stances_name, e))?;
+        Ok(true)
+    }
+
+    /// Answers at most one pending control request with `handle(command)`; returns whether
+    /// there was one.
+    pub fn serve_control(
+        &self,
+        handle: impl FnOnce(ControlCommand) -> ControlReply,
+    ) -> Result<bool, ShmError> {
+        let Some(request) = self
+            .control
+            .receive()
+            .map_err(|e| ShmError::ipc("receive from", &self.control_name, e))?
+        else {
+            return Ok(false);
+        };
+        let reply = handle(request.payload().command);
+        request
+            .send_copy(reply)
+            .map_err(|e| ShmError::ipc("reply on", &self.control_name, e))?;
+        Ok(true)
+    }
+}

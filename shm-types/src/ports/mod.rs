@@ -1,0 +1,11 @@
+//! Typed port wrappers, one per role. Each owns its own iceoryx2 node, so a process can give
+//! each of its threads the ports it needs (iceoryx2 `ipc` ports are not shared between threads).
+
+mod adapter;
+mod client;
+mod daemon;
+mod stream;
+
+pub use adapter::AdapterPorts;
+pub use client::ClientPorts;
+pub use daemon::{DaemonLoopPorts, DaemonServicePorts};

@@ -1,0 +1,124 @@
+//! The two ends of a high-rate stream (`sensors`, `commands`): a publisher that wakes its
+//! listeners after every message, and a subscriber that waits for that wake-up and keeps only
+//! the newest message. Shared by the daemon and the adapter, which use it in opposite directions.
+
+use core::time::Duration;
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::listener::ListenerWaitError;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+
+use crate::ShmError;
+use crate::services::{Event, PubSub};
+
+/// Sending end: publish + notify.
+pub(crate) struct StreamSender<T: core::fmt::Debug + ZeroCopySend + 'static> {
+    service_name: String,
+    publisher: Publisher<ipc::Service, T, ()>,
+    notifier: Notifier<ipc::Service>,
+    _service: PubSub<T>,
+    _event: Event,
+}
+
+impl<T: core::fmt::Debug + ZeroCopySend + Default + 'static> StreamSender<T> {
+    pub(crate) fn new(
+        service_name: String,
+        service: PubSub<T>,
+        event: Event,
+    ) -> Result<Self, ShmError> {
+        let publisher = service
+            .publisher_builder()
+            .max_loaned_samples(2)
+            .create()
+            .map_err(|e| ShmError::ipc("create publisher on", &service_name, e))?;
+        let notifier = event
+            .notifier_builder()
+            .create()
+            .map_err(|e| ShmError::ipc("create notifier on", &service_name, e))?;
+        Ok(Self {
+            service_name,
+            publisher,
+            notifier,
+            _service: service,
+            _event: event,
+        })
+    }
+
+    /// Fills a message in shared memory in place, sends it and wakes the listeners.
+    /// No heap allocation.
+    pub(crate) fn send(&self, fill: impl FnOnce(&mut T)) -> Result<(), ShmError> {
+        let mut sample = self
+            .publisher
+            .loan()
+            .map_err(|e| ShmError::ipc("loan a sample on", &self.service_name, e))?;
+        fill(sample.payload_mut());
+        sample
+            .send()
+            .map_err(|e| ShmError::ipc("send on", &self.service_name, e))?;
+        self.notifier
+            .notify()
+            .map_err(|e| ShmError::ipc("notify on", &self.service_name, e))?;
+        Ok(())
+    }
+}
+
+/// Receiving end: wait for the wake-up, take the newest message.
+pub(crate) struct StreamReceiver<T: core::fmt::Debug + ZeroCopySend + 'static> {
+    service_name: String,
+    subscriber: Subscriber<ipc::Service, T, ()>,
+    listener: Listener<ipc::Service>,
+    _service: PubSub<T>,
+    _event: Event,
+}
+
+impl<T: core::fmt::Debug + ZeroCopySend + Copy + 'static> StreamReceiver<T> {
+    pub(crate) fn new(
+        service_name: String,
+        service: PubSub<T>,
+        event: Event,
+    ) -> Result<Self, ShmError> {
+        let subscriber = service
+            .subscriber_builder()
+            .create()
+            .map_err(|e| ShmError::ipc("create subscriber on", &service_name, e))?;
+        let listener = event
+            .listener_builder()
+            .create()
+            .map_err(|e| ShmError::ipc("create listener on", &service_name, e))?;
+        Ok(Self {
+            service_name,
+            subscriber,
+            listener,
+            _service: service,
+            _event: event,
+        })
+    }
+
+    /// Blocks until a message is announced or `timeout` passes; returns whether one was
+    /// announced. A signal interrupting the wait counts as a timeout.
+    pub(crate) fn wait(&self, timeout: Duration) -> Result<bool, ShmError> {
+        match self.listener.timed_wait(|_| {}, timeout) {
+            Ok(count) => Ok(count > 0),
+            Err(ListenerWaitError::InterruptSignal) => Ok(false),
+            Err(e) => Err(ShmError::ipc("wait for", &self.service_name, e)),
+        }
+    }
+
+    /// Copies the newest received message into `out`, dropping older ones; returns false when
+    /// nothing new arrived. No heap allocation.
+    pub(crate) fn take_latest(&self, out: &mut T) -> Result<bool, ShmError> {
+        let mut fresh = false;
+        while let Some(sample) = self
+            .subscriber
+            .receive()
+            .map_err(|e| ShmError::ipc("receive from", &self.service_name, e))?
+        {
+            *out = *sample.payload();
+            fresh = true;
+        }
+        Ok(fresh)
+    }
+}

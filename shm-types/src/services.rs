@@ -1,0 +1,275 @@
+//! Service names under a robot's prefix and the one place where every service's QoS is set.
+//!
+//! All roles open services through these functions so their settings always agree (iceoryx2
+//! treats the settings of an opener as minimum requirements of the existing service).
+
+use core::time::Duration;
+
+use iceoryx2::prelude::*;
+use iceoryx2::service::builder::event::EventOpenOrCreateError;
+use iceoryx2::service::builder::publish_subscribe::{
+    PublishSubscribeOpenError, PublishSubscribeOpenOrCreateError,
+};
+use iceoryx2::service::builder::request_response::{
+    RequestResponseOpenError, RequestResponseOpenOrCreateError,
+};
+use iceoryx2::service::port_factory::{event, publish_subscribe, request_response};
+
+use crate::{
+    ControlReply, ControlRequest, DaemonStatus, JointCommand, PROTOCOL_VERSION, SensorSample,
+    ShmError, SubmitReply,
+};
+
+/// The names of one robot's services: `<prefix>/sensors`, `<prefix>/commands`, ...
+#[derive(Debug, Clone)]
+pub struct ServiceNames {
+    prefix: String,
+}
+
+/// The service kinds, used to build names.
+const SENSORS: &str = "sensors";
+const COMMANDS: &str = "commands";
+const STATUS: &str = "status";
+const STANCES: &str = "stances";
+const CONTROL: &str = "control";
+
+impl ServiceNames {
+    /// Names under `prefix` (e.g. `walk/armar4`); fails if a resulting name is not a valid
+    /// iceoryx2 service name.
+    pub fn new(prefix: &str) -> Result<Self, ShmError> {
+        let names = Self {
+            prefix: prefix.trim_end_matches('/').to_owned(),
+        };
+        if names.prefix.is_empty() {
+            return Err(ShmError::InvalidServiceName {
+                name: prefix.to_owned(),
+                detail: "the service prefix is empty".to_owned(),
+            });
+        }
+        for kind in [SENSORS, COMMANDS, STATUS, STANCES, CONTROL] {
+            names.service_name(kind)?;
+        }
+        Ok(names)
+    }
+
+    /// The prefix these names live under.
+    pub fn prefix(&self) -> &str {
+        &self.prefix
+    }
+
+    /// The full name of one service, e.g. `walk/armar4/sensors`.
+    pub fn full(&self, kind: &str) -> String {
+        format!("{}/{kind}", self.prefix)
+    }
+
+    fn service_name(&self, kind: &str) -> Result<ServiceName, ShmError> {
+        let name = self.full(kind);
+        ServiceName::new(&name).map_err(|e| ShmError::InvalidServiceName {
+            name,
+            detail: format!("{e:?}"),
+        })
+    }
+}
+
+/// The kind of iceoryx2 node every process of this system uses.
+pub type IpcNode = Node<ipc::Service>;
+
+/// Creates a node that installs no signal handlers: each process decides what SIGTERM means.
+/// Also removes the resources of dead nodes (e.g. a `kill -9`ed daemon) so the services can be
+/// reused at once; returns how many dead nodes were found and cleaned.
+pub fn create_node(name: &str) -> Result<(IpcNode, u64), ShmError> {
+    set_log_level_from_env_or(LogLevel::Error);
+    let dead_before = count_dead_nodes();
+    let node_name = NodeName::new(name).map_err(|e| ShmError::ipc("name node", name, e))?;
+    let node = NodeBuilder::new()
+        .name(&node_name)
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(|e| ShmError::ipc("create node", name, e))?;
+    node.try_cleanup_dead_nodes();
+    Ok((node, dead_before.saturating_sub(count_dead_nodes())))
+}
+
+/// Number of nodes whose process died without releasing them.
+fn count_dead_nodes() -> u64 {
+    let mut dead = 0;
+    // A failing listing only means there is nothing to report.
+    let _ = IpcNode::list(Config::global_config(), |state| {
+        if matches!(state, NodeState::Dead(_)) {
+            dead += 1;
+        }
+        CallbackProgression::Continue
+    });
+    dead
+}
+
+pub(crate) type PubSub<T> = publish_subscribe::PortFactory<ipc::Service, T, ()>;
+pub(crate) type Event = event::PortFactory<ipc::Service>;
+pub(crate) type SubmitService =
+    request_response::PortFactory<ipc::Service, [u8], (), SubmitReply, ()>;
+pub(crate) type ControlService =
+    request_response::PortFactory<ipc::Service, ControlRequest, (), ControlReply, ()>;
+
+/// Whether the caller may create a missing service (daemon, adapter) or only open it (client).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Access {
+    OpenOrCreate,
+    OpenOnly,
+}
+
+fn pubsub_error(service: &str, error: PublishSubscribeOpenOrCreateError) -> ShmError {
+    match error {
+        PublishSubscribeOpenOrCreateError::PublishSubscribeOpenError(e) => {
+            pubsub_open_error(service, e)
+        }
+        other => ShmError::ipc("open or create", service, other),
+    }
+}
+
+fn pubsub_open_error(service: &str, error: PublishSubscribeOpenError) -> ShmError {
+    match error {
+        PublishSubscribeOpenError::IncompatibleTypes => ShmError::ProtocolMismatch {
+            service: service.to_owned(),
+            ours: PROTOCOL_VERSION,
+        },
+        PublishSubscribeOpenError::DoesNotExist => ShmError::NotRunning {
+            service: service.to_owned(),
+        },
+        other => ShmError::ipc("open", service, other),
+    }
+}
+
+fn request_response_error(service: &str, error: RequestResponseOpenError) -> ShmError {
+    match error {
+        RequestResponseOpenError::IncompatibleRequestOrResponseType => ShmError::ProtocolMismatch {
+            service: service.to_owned(),
+            ours: PROTOCOL_VERSION,
+        },
+        RequestResponseOpenError::DoesNotExist => ShmError::NotRunning {
+            service: service.to_owned(),
+        },
+        other => ShmError::ipc("open", service, other),
+    }
+}
+
+/// A high-rate stream (sensors, commands): newest wins, a late subscriber gets the last one.
+fn stream<T: core::fmt::Debug + ZeroCopySend + 'static>(
+    node: &IpcNode,
+    names: &ServiceNames,
+    kind: &str,
+) -> Result<PubSub<T>, ShmError> {
+    let service = names.full(kind);
+    node.service_builder(&names.service_name(kind)?)
+        .publish_subscribe::<T>()
+        .enable_safe_overflow(true)
+        .history_size(1)
+        .subscriber_max_buffer_size(4)
+        .subscriber_max_borrowed_samples(4)
+        .max_publishers(2)
+        .max_subscribers(8)
+        .open_or_create()
+        .map_err(|e| pubsub_error(&service, e))
+}
+
+/// The wake-up event that accompanies a stream.
+fn stream_event(node: &IpcNode, names: &ServiceNames, kind: &str) -> Result<Event, ShmError> {
+    let service = names.full(kind);
+    node.service_builder(&names.service_name(kind)?)
+        .event()
+        .max_notifiers(4)
+        .max_listeners(8)
+        .open_or_create()
+        .map_err(|e: EventOpenOrCreateError| ShmError::ipc("open or create event", &service, e))
+}
+
+pub(crate) fn sensors(
+    node: &IpcNode,
+    names: &ServiceNames,
+) -> Result<PubSub<SensorSample>, ShmError> {
+    stream(node, names, SENSORS)
+}
+
+pub(crate) fn sensors_event(node: &IpcNode, names: &ServiceNames) -> Result<Event, ShmError> {
+    stream_event(node, names, SENSORS)
+}
+
+pub(crate) fn commands(
+    node: &IpcNode,
+    names: &ServiceNames,
+) -> Result<PubSub<JointCommand>, ShmError> {
+    stream(node, names, COMMANDS)
+}
+
+pub(crate) fn commands_event(node: &IpcNode, names: &ServiceNames) -> Result<Event, ShmError> {
+    stream_event(node, names, COMMANDS)
+}
+
+pub(crate) fn status(
+    node: &IpcNode,
+    names: &ServiceNames,
+    access: Access,
+) -> Result<PubSub<DaemonStatus>, ShmError> {
+    let service = names.full(STATUS);
+    let builder = node
+        .service_builder(&names.service_name(STATUS)?)
+        .publish_subscribe::<DaemonStatus>()
+        .enable_safe_overflow(true)
+        .history_size(1)
+        .subscriber_max_buffer_size(2)
+        .subscriber_max_borrowed_samples(2)
+        .max_publishers(2)
+        .max_subscribers(16);
+    match access {
+        Access::OpenOrCreate => builder
+            .open_or_create()
+            .map_err(|e| pubsub_error(&service, e)),
+        Access::OpenOnly => builder.open().map_err(|e| pubsub_open_error(&service, e)),
+    }
+}
+
+/// Opens a client → daemon request-response service: few clients, one answer per request.
+/// (A macro because iceoryx2's builder has distinct impls for sized and slice requests.)
+macro_rules! request_response_service {
+    ($node:expr, $names:expr, $kind:expr, $access:expr, $req:ty, $resp:ty) => {{
+        let service = $names.full($kind);
+        let builder = $node
+            .service_builder(&$names.service_name($kind)?)
+            .request_response::<$req, $resp>()
+            .max_clients(8)
+            .max_servers(2)
+            .max_active_requests_per_client(2)
+            .max_response_buffer_size(2);
+        match $access {
+            Access::OpenOrCreate => builder.open_or_create().map_err(|e| match e {
+                RequestResponseOpenOrCreateError::RequestResponseOpenError(e) => {
+                    request_response_error(&service, e)
+                }
+                other => ShmError::ipc("open or create", &service, other),
+            }),
+            Access::OpenOnly => builder
+                .open()
+                .map_err(|e| request_response_error(&service, e)),
+        }
+    }};
+}
+
+pub(crate) fn stances(
+    node: &IpcNode,
+    names: &ServiceNames,
+    access: Access,
+) -> Result<SubmitService, ShmError> {
+    request_response_service!(node, names, STANCES, access, [u8], SubmitReply)
+}
+
+pub(crate) fn control(
+    node: &IpcNode,
+    names: &ServiceNames,
+    access: Access,
+) -> Result<ControlService, ShmError> {
+    request_response_service!(node, names, CONTROL, access, ControlRequest, ControlReply)
+}
+
+/// Converts an absolute time on [`crate::monotonic_ns`] into the timeout left until then.
+pub fn time_until(deadline_ns: u64) -> Duration {
+    Duration::from_nanos(deadline_ns.saturating_sub(crate::monotonic_ns()))
+}

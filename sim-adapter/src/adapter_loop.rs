@@ -1,0 +1,238 @@
+//! The adapter loop shared by the simulator and hardware adapters.
+
+use std::time::Duration;
+
+use shm_types::{
+    AdapterPorts, ClockMode, CommandMode, JointCommand, MAX_JOINTS, SensorSample, ShmError,
+    monotonic_ns, sleep_until,
+};
+
+use crate::RobotIo;
+
+/// Longest single wait, so a stop request is seen quickly.
+const MAX_WAIT: Duration = Duration::from_millis(20);
+
+/// How the loop is clocked and when it holds.
+#[derive(Debug, Clone, Copy)]
+pub struct AdapterOptions {
+    /// Realtime: a sample every period on absolute deadlines. Lockstep: the next sample when the
+    /// command answering the previous one arrives.
+    pub clock: ClockMode,
+    /// Sample rate (realtime) and simulated time step `1 / rate_hz` (both modes).
+    pub rate_hz: f64,
+    /// Realtime: periods without a fresh command before holding position.
+    pub watchdog_periods: u32,
+    /// Lockstep: wall time without the awaited command before holding position (and
+    /// re-publishing the current sample so a restarted daemon can pick up).
+    pub lockstep_timeout: Duration,
+}
+
+/// What happened during a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct AdapterReport {
+    /// Samples published.
+    pub samples: u64,
+    /// Fresh commands applied.
+    pub commands: u64,
+    /// Times the command watchdog tripped and the adapter started holding.
+    pub watchdog_trips: u64,
+    /// Realtime periods skipped because the loop overran.
+    pub overruns: u64,
+}
+
+/// Why the loop stopped early.
+#[derive(Debug, thiserror::Error)]
+pub enum AdapterError {
+    /// The robot has more joints than the messages can carry.
+    #[error("the robot has {0} joints, the protocol carries at most {MAX_JOINTS}")]
+    TooManyJoints(usize),
+    /// An IPC operation failed.
+    #[error(transparent)]
+    Ipc(#[from] ShmError),
+}
+
+/// The setpoint the robot is driven with: the daemon's latest command or a hold posture.
+struct Setpoint {
+    holding: bool,
+    q: [f64; MAX_JOINTS],
+    qd: [f64; MAX_JOINTS],
+}
+
+impl Setpoint {
+    /// Hold the posture of `sample` (zero velocity).
+    fn hold(&mut self, sample: &SensorSample) {
+        self.holding = true;
+        self.q = sample.q;
+        self.qd = [0.0; MAX_JOINTS];
+    }
+
+    /// Follow `command` (a hold command keeps its posture with zero velocity).
+    fn follow(&mut self, command: &JointCommand) {
+        self.holding = false;
+        self.q = command.q_des;
+        self.qd = match command.mode {
+            CommandMode::Track => command.qd_des,
+            CommandMode::Hold => [0.0; MAX_JOINTS],
+        };
+    }
+}
+
+/// The loop's state between periods.
+struct Adapter<'a, R: RobotIo> {
+    ports: &'a AdapterPorts,
+    robot: &'a mut R,
+    options: AdapterOptions,
+    joints: usize,
+    dt: f64,
+    sample: SensorSample,
+    command: JointCommand,
+    setpoint: Setpoint,
+    report: AdapterReport,
+    write_failed: bool,
+}
+
+impl<R: RobotIo> Adapter<'_, R> {
+    /// Reads the robot and publishes the next sample.
+    fn publish(&mut self) -> Result<(), ShmError> {
+        self.robot.read(&mut self.sample);
+        self.sample.seq += 1;
+        self.sample.joint_count = self.joints as u32;
+        self.sample.adapter_holding = self.setpoint.holding;
+        let sample = &self.sample;
+        self.ports.publish_sample(|out| *out = *sample)?;
+        self.report.samples += 1;
+        Ok(())
+    }
+
+    /// Applies the current setpoint for one period. A setpoint the robot rejects (e.g. NaN)
+    /// makes the adapter hold instead.
+    fn apply(&mut self) {
+        let n = self.joints;
+        if let Err(error) = self
+            .robot
+            .write(&self.setpoint.q[..n], &self.setpoint.qd[..n], self.dt)
+        {
+            if !self.write_failed {
+                tracing::error!(%error, "setpoint rejected by the robot: holding position");
+                self.write_failed = true;
+            }
+            self.setpoint.hold(&self.sample);
+            // The hold posture is the last reading, which the robot accepted before.
+            let _ = self
+                .robot
+                .write(&self.setpoint.q[..n], &self.setpoint.qd[..n], self.dt);
+        }
+    }
+
+    /// Starts holding because commands went stale.
+    fn trip_watchdog(&mut self, why: &str) {
+        if !self.setpoint.holding {
+            tracing::warn!("{why}: holding position");
+            self.report.watchdog_trips += 1;
+        }
+        self.setpoint.hold(&self.sample);
+    }
+
+    /// Takes a fresh command if one arrived (in lockstep only the one answering our last sample).
+    fn take_command(&mut self, must_answer_last: bool) -> Result<bool, ShmError> {
+        if !self.ports.take_latest_command(&mut self.command)? {
+            return Ok(false);
+        }
+        if must_answer_last && self.command.answers_seq != self.sample.seq {
+            return Ok(false);
+        }
+        if self.setpoint.holding && self.report.commands > 0 {
+            tracing::info!("commands are fresh again: following the daemon");
+        }
+        self.setpoint.follow(&self.command);
+        self.write_failed = false;
+        self.report.commands += 1;
+        Ok(true)
+    }
+
+    fn run_realtime(&mut self, should_stop: &dyn Fn() -> bool) -> Result<(), ShmError> {
+        let period = (1e9 / self.options.rate_hz) as u64;
+        let mut stale_periods = 0;
+        self.publish()?;
+        let mut deadline = monotonic_ns() + period;
+        while !should_stop() {
+            sleep_until(deadline);
+            if self.take_command(false)? {
+                stale_periods = 0;
+            } else {
+                stale_periods += 1;
+                if stale_periods >= self.options.watchdog_periods {
+                    self.trip_watchdog("no fresh command within the watchdog periods");
+                }
+            }
+            self.apply();
+            self.publish()?;
+            deadline += period;
+            let now = monotonic_ns();
+            if now > deadline {
+                let skipped = (now - deadline) / period + 1;
+                self.report.overruns += skipped;
+                deadline += skipped * period;
+            }
+        }
+        Ok(())
+    }
+
+    fn run_lockstep(&mut self, should_stop: &dyn Fn() -> bool) -> Result<(), ShmError> {
+        let timeout = self.options.lockstep_timeout.as_nanos() as u64;
+        self.publish()?;
+        let mut last_progress = monotonic_ns();
+        while !should_stop() {
+            self.ports.wait_for_command(MAX_WAIT)?;
+            if self.take_command(true)? {
+                self.apply();
+                self.publish()?;
+                last_progress = monotonic_ns();
+            } else if monotonic_ns() - last_progress > timeout {
+                self.trip_watchdog("no command answered the last sample in time");
+                // Time stands still in lockstep: re-publish the reading so a (re)started daemon
+                // gets a sample to answer.
+                self.publish()?;
+                last_progress = monotonic_ns();
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Runs the adapter until `should_stop()` says so: publishes samples of `robot`, applies the daemon's
+/// commands, and holds position whenever commands go stale (also before the first command).
+pub fn run_adapter<R: RobotIo>(
+    ports: &AdapterPorts,
+    robot: &mut R,
+    options: &AdapterOptions,
+    should_stop: &dyn Fn() -> bool,
+) -> Result<AdapterReport, AdapterError> {
+    let joints = robot.joint_count();
+    if joints > MAX_JOINTS {
+        return Err(AdapterError::TooManyJoints(joints));
+    }
+    let mut adapter = Adapter {
+        ports,
+        robot,
+        options: *options,
+        joints,
+        dt: 1.0 / options.rate_hz,
+        sample: SensorSample::ZERO,
+        command: JointCommand::ZERO,
+        setpoint: Setpoint {
+            holding: true,
+            q: [0.0; MAX_JOINTS],
+            qd: [0.0; MAX_JOINTS],
+        },
+        report: AdapterReport::default(),
+        write_failed: false,
+    };
+    adapter.robot.read(&mut adapter.sample);
+    adapter.setpoint.hold(&adapter.sample);
+    match options.clock {
+        ClockMode::Realtime => adapter.run_realtime(should_stop)?,
+        ClockMode::Lockstep => adapter.run_lockstep(should_stop)?,
+    }
+    Ok(adapter.report)
+}

@@ -1,0 +1,289 @@
+//! Writes the MuJoCo model (MJCF) of a robot standing on a floor.
+//!
+//! Generated from the URDF's kinematics and inertials (see `bodies`) rather than loaded with
+//! MuJoCo's URDF importer, so no mesh is needed and every modelling choice is explicit:
+//! - a free joint on the base and an infinite floor plane at z = 0;
+//! - one hinge/slide joint per actuated joint, with the URDF limits, armature and damping;
+//! - collision geometry only where contact is meaningful: one box per foot, the configured sole
+//!   rectangle with its bottom face on the sole frame, colliding with the floor and nothing else;
+//! - sites at every end-effector frame, both FT frames and the base (the IMU);
+//! - per joint a position and a velocity actuator (the servo), in model joint order;
+//! - IMU sensors (orientation, gyro, accelerometer) at the base site.
+
+use std::fmt::Write;
+
+use kinematics::model::{FrameId, Model};
+use kinematics::robot::{EndEffector, Robot};
+use nalgebra::{Isometry3, Translation3, Vector3};
+
+use super::MujocoError;
+use super::bodies::{MassProperties, RigidBodies};
+use super::options::MujocoOptions;
+
+/// Name of the floating base's free joint.
+pub(crate) const FREE_JOINT: &str = "floating_base";
+/// Site name of the IMU at the floating base origin (the URDF root link).
+pub(crate) const IMU_SITE: &str = "imu";
+/// Site names of the FT frames (left foot, right foot).
+pub(crate) const FT_SITES: [&str; 2] = ["left_foot_ft", "right_foot_ft"];
+/// Geom names of the foot collision boxes (left, right).
+pub(crate) const FOOT_GEOMS: [&str; 2] = ["left_sole", "right_sole"];
+/// Sensor data layout: base orientation quaternion (w, x, y, z), gyro, accelerometer.
+pub(crate) const IMU_QUAT: std::ops::Range<usize> = 0..4;
+pub(crate) const IMU_GYRO: std::ops::Range<usize> = 4..7;
+pub(crate) const IMU_ACCEL: std::ops::Range<usize> = 7..10;
+
+/// Site name of an end-effector frame.
+pub(crate) fn end_effector_site(effector: EndEffector) -> &'static str {
+    effector.name()
+}
+
+/// The MJCF document of `robot` built from `bodies`.
+pub(crate) fn write(
+    robot: &Robot,
+    bodies: &RigidBodies,
+    options: &MujocoOptions,
+) -> Result<String, MujocoError> {
+    let mut xml = String::with_capacity(64 * 1024);
+    let o = options;
+    // `write!` into a String cannot fail; the results are ignored throughout.
+    let _ = writeln!(xml, r#"<mujoco model="{}">"#, escape(robot.model.name()));
+    let _ = writeln!(
+        xml,
+        r#"  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>"#
+    );
+    let _ = writeln!(
+        xml,
+        r#"  <option timestep="{}" integrator="implicitfast" gravity="0 0 -{}" cone="elliptic"/>"#,
+        o.timestep,
+        kinematic_sim::GRAVITY
+    );
+    let _ = writeln!(xml, "  <default>");
+    let _ = writeln!(
+        xml,
+        r#"    <joint armature="{}" damping="{}"/>"#,
+        o.armature, o.joint_damping
+    );
+    let _ = writeln!(
+        xml,
+        r#"    <geom contype="0" conaffinity="0" condim="3" friction="{} 0.005 0.0001" solref="{} 1"/>"#,
+        o.friction, o.contact_time_constant
+    );
+    let _ = writeln!(xml, "  </default>");
+    let _ = writeln!(xml, "  <worldbody>");
+    // The floor collides with whatever has conaffinity 1: only the feet.
+    let _ = writeln!(
+        xml,
+        r#"    <geom name="floor" type="plane" size="0 0 1" contype="1"/>"#
+    );
+    let attachments = Attachments::collect(robot, bodies, o.sole_thickness)?;
+    write_body(&mut xml, robot, bodies, &attachments, 0, 2);
+    let _ = writeln!(xml, "  </worldbody>");
+    let _ = writeln!(xml, "  <actuator>");
+    for joint in robot.model.joint_names() {
+        let name = escape(joint);
+        let _ = writeln!(
+            xml,
+            r#"    <position joint="{name}" kp="{}"/>"#,
+            o.servo_stiffness
+        );
+        let _ = writeln!(
+            xml,
+            r#"    <velocity joint="{name}" kv="{}"/>"#,
+            o.servo_damping
+        );
+    }
+    let _ = writeln!(xml, "  </actuator>");
+    let _ = writeln!(xml, "  <sensor>");
+    let _ = writeln!(
+        xml,
+        r#"    <framequat objtype="site" objname="{IMU_SITE}"/>"#
+    );
+    let _ = writeln!(xml, r#"    <gyro site="{IMU_SITE}"/>"#);
+    let _ = writeln!(xml, r#"    <accelerometer site="{IMU_SITE}"/>"#);
+    let _ = writeln!(xml, "  </sensor>");
+    let _ = writeln!(xml, "</mujoco>");
+    Ok(xml)
+}
+
+/// A site or geom hung on a rigid body.
+struct Attachment {
+    body: usize,
+    pose: Isometry3<f64>,
+    kind: AttachmentKind,
+}
+
+enum AttachmentKind {
+    Site(&'static str),
+    /// A foot collision box: (name, half extents).
+    SoleBox(&'static str, Vector3<f64>),
+}
+
+struct Attachments(Vec<Attachment>);
+
+impl Attachments {
+    fn collect(
+        robot: &Robot,
+        bodies: &RigidBodies,
+        sole_thickness: f64,
+    ) -> Result<Self, MujocoError> {
+        let mut all = vec![Attachment {
+            body: 0,
+            pose: Isometry3::identity(),
+            kind: AttachmentKind::Site(IMU_SITE),
+        }];
+        for effector in EndEffector::ALL {
+            let (body, pose) = place_frame(&robot.model, bodies, robot.frame(effector))?;
+            all.push(Attachment {
+                body,
+                pose,
+                kind: AttachmentKind::Site(end_effector_site(effector)),
+            });
+        }
+        let half = Vector3::new(robot.sole.length, robot.sole.width, sole_thickness) / 2.0;
+        let feet = [EndEffector::LeftFoot, EndEffector::RightFoot];
+        for ((foot, geom), (&ft_frame, ft_site)) in feet
+            .into_iter()
+            .zip(FOOT_GEOMS)
+            .zip(robot.ft_sensors.iter().zip(FT_SITES))
+        {
+            let (body, sole) = place_frame(&robot.model, bodies, robot.frame(foot))?;
+            // The box's bottom face lies on the sole plane: its centre is half a thickness above.
+            let pose = sole * Translation3::new(0.0, 0.0, half.z);
+            all.push(Attachment {
+                body,
+                pose,
+                kind: AttachmentKind::SoleBox(geom, half),
+            });
+            let (body, pose) = place_frame(&robot.model, bodies, ft_frame)?;
+            all.push(Attachment {
+                body,
+                pose,
+                kind: AttachmentKind::Site(ft_site),
+            });
+        }
+        Ok(Self(all))
+    }
+}
+
+/// Body index and pose in that body of a kinematic-model frame.
+fn place_frame(
+    model: &Model,
+    bodies: &RigidBodies,
+    frame: FrameId,
+) -> Result<(usize, Isometry3<f64>), MujocoError> {
+    let link = model.link_name(model.frame_link(frame));
+    let placement = bodies.links.get(link).ok_or_else(|| {
+        MujocoError::ModelMismatch(format!(
+            "frame '{}' is attached to link '{link}', which the URDF does not have",
+            model.frame_name(frame)
+        ))
+    })?;
+    Ok((placement.body, placement.offset * model.frame_offset(frame)))
+}
+
+fn write_body(
+    xml: &mut String,
+    robot: &Robot,
+    bodies: &RigidBodies,
+    attachments: &Attachments,
+    index: usize,
+    depth: usize,
+) {
+    let body = &bodies.bodies[index];
+    let pad = "  ".repeat(depth);
+    let _ = writeln!(
+        xml,
+        r#"{pad}<body name="{}" {}>"#,
+        escape(&body.name),
+        pose_attributes(&body.origin)
+    );
+    match &body.joint {
+        None => {
+            let _ = writeln!(xml, r#"{pad}  <freejoint name="{FREE_JOINT}"/>"#);
+        }
+        Some(joint) => {
+            let limits = &robot.model.joint_limits()[joint.index];
+            let kind = if joint.revolute { "hinge" } else { "slide" };
+            let range = if limits.lower.is_finite() && limits.upper.is_finite() {
+                format!(r#" range="{} {}""#, limits.lower, limits.upper)
+            } else {
+                String::new()
+            };
+            let a = joint.axis;
+            let _ = writeln!(
+                xml,
+                r#"{pad}  <joint name="{}" type="{kind}" axis="{} {} {}"{range}/>"#,
+                escape(&joint.name),
+                a.x,
+                a.y,
+                a.z
+            );
+        }
+    }
+    write_inertial(xml, &pad, &body.mass);
+    for attachment in attachments.0.iter().filter(|a| a.body == index) {
+        match attachment.kind {
+            AttachmentKind::Site(name) => {
+                let _ = writeln!(
+                    xml,
+                    r#"{pad}  <site name="{name}" {}/>"#,
+                    pose_attributes(&attachment.pose)
+                );
+            }
+            AttachmentKind::SoleBox(name, half) => {
+                let _ = writeln!(
+                    xml,
+                    r#"{pad}  <geom name="{name}" type="box" size="{} {} {}" conaffinity="1" {}/>"#,
+                    half.x,
+                    half.y,
+                    half.z,
+                    pose_attributes(&attachment.pose)
+                );
+            }
+        }
+    }
+    for child in (0..bodies.bodies.len()).filter(|&c| bodies.bodies[c].parent == Some(index)) {
+        write_body(xml, robot, bodies, attachments, child, depth + 1);
+    }
+    let _ = writeln!(xml, "{pad}</body>");
+}
+
+fn write_inertial(xml: &mut String, pad: &str, mass: &MassProperties) {
+    if mass.mass <= 0.0 {
+        return;
+    }
+    let (c, i) = (&mass.com, &mass.inertia);
+    let _ = writeln!(
+        xml,
+        r#"{pad}  <inertial pos="{} {} {}" mass="{}" fullinertia="{} {} {} {} {} {}"/>"#,
+        c.x,
+        c.y,
+        c.z,
+        mass.mass,
+        i[(0, 0)],
+        i[(1, 1)],
+        i[(2, 2)],
+        i[(0, 1)],
+        i[(0, 2)],
+        i[(1, 2)]
+    );
+}
+
+/// `pos` and `quat` (w x y z) attributes of a pose, full precision.
+fn pose_attributes(pose: &Isometry3<f64>) -> String {
+    let t = &pose.translation.vector;
+    let q = pose.rotation.quaternion();
+    format!(
+        r#"pos="{} {} {}" quat="{} {} {} {}""#,
+        t.x, t.y, t.z, q.w, q.i, q.j, q.k
+    )
+}
+
+/// Escapes a name for an XML attribute value.
+fn escape(name: &str) -> String {
+    name.replace('&', "&amp;")
+        .replace('"', "&quot;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}

@@ -1,0 +1,24 @@
+//! The MuJoCo physics backend (`walk-sim --physics mujoco`): the robot under rigid-body dynamics
+//! with contacts, driven like the kinematic simulator.
+//!
+//! Built behind the `mujoco` cargo feature; the library is fetched by `scripts/setup-mujoco.sh`
+//! (see `docs/mujoco.md`). The model is generated from the URDF's kinematics and inertials plus
+//! the `[robot]` section's frames (`mjcf` documents every modelling choice); [`MujocoSim`] steps
+//! it with joint servos tracking `q_des` / `q̇_des` and reports the same [`SimMeasurement`]
+//! record as `kinematic_sim::KinematicSim`, plus base height and tilt for fall detection.
+//! [`MujocoRobot`] puts it behind [`crate::RobotIo`] for the adapter loop.
+//!
+//! [`SimMeasurement`]: kinematic_sim::SimMeasurement
+
+mod bodies;
+mod contact;
+mod error;
+mod mjcf;
+mod options;
+mod robot_io;
+mod sim;
+
+pub use error::MujocoError;
+pub use options::MujocoOptions;
+pub use robot_io::MujocoRobot;
+pub use sim::MujocoSim;

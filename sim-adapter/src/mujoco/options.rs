@@ -1,0 +1,48 @@
+//! Tunable parameters of the MuJoCo model; the defaults suit the vendored humanoids.
+
+/// How the physics model is built and stepped.
+///
+/// Joint servos are position + velocity actuators: `τ = kp·(q_des − q) + kv·(q̇_des − q̇)`, the way
+/// a position-controlled robot's joint controller behaves. The velocity term is integrated
+/// implicitly (`implicitfast`), the position term explicitly; the joint armature bounds how stiff
+/// the servo can be at a given time step (`kp·timestep² / armature` must stay well below 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MujocoOptions {
+    /// Physics time step (s); `step(dt)` runs as many of these as fit in `dt`.
+    pub timestep: f64,
+    /// Servo stiffness kp (N·m/rad for revolute joints, N/m for prismatic ones).
+    pub servo_stiffness: f64,
+    /// Servo damping kv (N·m·s/rad, N·s/m).
+    pub servo_damping: f64,
+    /// Rotor inertia added to every joint (kg·m²); keeps stiff servos stable on light links.
+    pub armature: f64,
+    /// Passive viscous damping of every joint (N·m·s/rad).
+    pub joint_damping: f64,
+    /// Sliding friction coefficient between the soles and the floor.
+    pub friction: f64,
+    /// Height of the foot collision boxes (m); their bottom face lies on the sole plane.
+    pub sole_thickness: f64,
+    /// Contact time constant (s) of MuJoCo's soft contacts (`solref`); at least 2 × `timestep`.
+    pub contact_time_constant: f64,
+    /// The robot has fallen when its base link is below this fraction of its initial height.
+    pub fall_height_fraction: f64,
+    /// ... or when the base link's z axis tilts more than this from vertical (rad).
+    pub fall_tilt: f64,
+}
+
+impl Default for MujocoOptions {
+    fn default() -> Self {
+        Self {
+            timestep: 0.001,
+            servo_stiffness: 30000.0,
+            servo_damping: 300.0,
+            armature: 0.05,
+            joint_damping: 0.0,
+            friction: 1.0,
+            sole_thickness: 0.02,
+            contact_time_constant: 0.005,
+            fall_height_fraction: 0.7,
+            fall_tilt: 0.6,
+        }
+    }
+}

@@ -1,0 +1,513 @@
+//! [`MujocoSim`]: the robot under rigid-body dynamics with contacts, stepped like the kinematic
+//! simulator (`step(q_des, q̇_des, dt)`, then read [`MujocoSim::measurement`]).
+
+use std::path::Path;
+use std::sync::Arc;
+
+use kinematic_sim::support::{SupportPolygon, sole_corners};
+use kinematic_sim::{SafetyMetrics, SafetySummary, SimMeasurement};
+use kinematics::configuration::Configuration;
+use kinematics::robot::{EndEffector, Robot};
+use mujoco_rs::prelude::{MjData, MjModel, MjtObjBase, MjtWarning};
+use nalgebra::{
+    DVector, Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3,
+};
+
+use super::bodies::RigidBodies;
+use super::contact::{self, FootContacts, FootIds};
+use super::mjcf;
+use super::{MujocoError, MujocoOptions};
+
+/// The MuJoCo version mujoco-rs 7.0.0 is built for (it refuses any other).
+const MUJOCO_VERSION: &str = "3.17.0";
+const FEET: [EndEffector; 2] = [EndEffector::LeftFoot, EndEffector::RightFoot];
+/// MuJoCo warnings that mean the state was unusable and MuJoCo reset it.
+const FATAL_WARNINGS: [MjtWarning; 3] = [
+    MjtWarning::mjWARN_BADQPOS,
+    MjtWarning::mjWARN_BADQVEL,
+    MjtWarning::mjWARN_BADQACC,
+];
+
+/// Where each quantity lives in MuJoCo's arrays, resolved once at construction.
+#[derive(Debug)]
+struct Layout {
+    /// `qpos` / `qvel` address of each actuated joint, model order.
+    joint_qpos: Vec<usize>,
+    joint_dof: Vec<usize>,
+    /// Body id of the floating base (the free joint's body) and its `qpos` / `qvel` address.
+    base_body: usize,
+    base_qpos: usize,
+    /// Site of each end-effector frame, by [`EndEffector`].
+    effector_sites: [usize; 4],
+    feet: FootIds,
+    /// The body the robot's `base_link` belongs to, and the link's pose in that body.
+    base_link_body: usize,
+    base_link_offset: Isometry3<f64>,
+}
+
+/// A robot standing on a flat floor under MuJoCo's rigid-body dynamics, driven by joint servos.
+///
+/// Deterministic: the same robot, options, initial state and commands give bit-identical states.
+/// Not real-time safe to construct (it compiles a model); [`MujocoSim::step`] does not allocate.
+pub struct MujocoSim {
+    robot: Arc<Robot>,
+    options: MujocoOptions,
+    data: MjData<Box<MjModel>>,
+    layout: Layout,
+    /// Contact readings of the last constraint solve.
+    contacts: FootContacts,
+    /// Sole pose of each foot when it last touched down (for the slip metric).
+    anchors: [Option<Isometry3<f64>>; 2],
+    polygon: SupportPolygon,
+    measurement: SimMeasurement,
+    summary: SafetySummary,
+    initial_base_height: f64,
+    /// Sum of the `dt`s stepped so far; the physics time follows it to within one time step.
+    commanded_time: f64,
+}
+
+impl MujocoSim {
+    /// Builds the physics model of `robot` (kinematics and inertials from `urdf`, the file the
+    /// robot was loaded from) and places it in `initial`, at rest.
+    pub fn new(
+        robot: Arc<Robot>,
+        urdf: &Path,
+        initial: &Configuration,
+        options: MujocoOptions,
+    ) -> Result<Self, MujocoError> {
+        check_library_version()?;
+        check_options(&options)?;
+        let dof = robot.model.dof();
+        if initial.joints.len() != dof {
+            return Err(MujocoError::CommandLength {
+                field: "initial.joints",
+                expected: dof,
+                actual: initial.joints.len(),
+            });
+        }
+        if let Some(index) = initial.joints.iter().position(|v| !v.is_finite()) {
+            let joint = robot.model.joint_names()[index].clone();
+            return Err(MujocoError::NonFiniteCommand {
+                field: "initial.joints",
+                index,
+                joint,
+            });
+        }
+        let base = &initial.base;
+        if !(base
+            .translation
+            .vector
+            .iter()
+            .chain(base.rotation.coords.iter()))
+        .all(|v| v.is_finite())
+        {
+            return Err(MujocoError::NonFiniteBase);
+        }
+        let parsed = urdf_rs::read_file(urdf).map_err(|error| MujocoError::Urdf {
+            path: urdf.to_owned(),
+            message: error.to_string(),
+        })?;
+        let bodies = RigidBodies::from_urdf(&parsed, &robot.model)?;
+        let xml = mjcf::write(&robot, &bodies, &options)?;
+        let model = MjModel::from_xml_string(&xml)
+            .map_err(|error| MujocoError::Compile(error.to_string()))?;
+        let layout = Layout::resolve(&model, &robot, &bodies)?;
+        let data = MjData::new(Box::new(model));
+        let measurement = SimMeasurement {
+            q: initial.joints.clone(),
+            qd: DVector::zeros(dof),
+            wrenches: [[0.0; 6]; 4],
+            base_orientation: initial.base.rotation,
+            base: initial.base,
+            com: Vector3::zeros(),
+            contacts: [false; 4],
+            safety: SafetyMetrics::default(),
+        };
+        let mut sim = Self {
+            robot,
+            options,
+            data,
+            layout,
+            contacts: FootContacts::default(),
+            anchors: [None, None],
+            polygon: SupportPolygon::empty(),
+            measurement,
+            summary: SafetySummary::default(),
+            initial_base_height: 0.0,
+            commanded_time: 0.0,
+        };
+        sim.place(initial);
+        sim.initial_base_height = sim.base_link_pose().translation.z;
+        Ok(sim)
+    }
+
+    /// The robot being simulated.
+    pub fn robot(&self) -> &Arc<Robot> {
+        &self.robot
+    }
+
+    /// The options the model was built with.
+    pub fn options(&self) -> &MujocoOptions {
+        &self.options
+    }
+
+    /// Simulated time since the start (s).
+    pub fn time(&self) -> f64 {
+        self.data.time()
+    }
+
+    /// The current sensor readings, ground truth and safety metrics (same record as the
+    /// kinematic simulator's): joint `q`/`q̇`, foot FT wrenches (hands read zero: only the floor
+    /// is modelled), the IMU orientation, and the true base pose, CoM and contacts.
+    pub fn measurement(&self) -> &SimMeasurement {
+        &self.measurement
+    }
+
+    /// Worst safety values since the start; `fell` is set by [`MujocoSim::has_fallen`]'s rule.
+    pub fn summary(&self) -> &SafetySummary {
+        &self.summary
+    }
+
+    /// The IMU at the floating base origin (the URDF root link): angular velocity (rad/s) and
+    /// specific force (m/s², from the last constraint solve), both in the base frame.
+    pub fn imu_rates(&self) -> (Vector3<f64>, Vector3<f64>) {
+        let s = self.data.sensordata();
+        (
+            Vector3::from_column_slice(&s[mjcf::IMU_GYRO]),
+            Vector3::from_column_slice(&s[mjcf::IMU_ACCEL]),
+        )
+    }
+
+    /// World pose of the configured `base_link` (the pelvis), for fall detection.
+    pub fn base_link_pose(&self) -> Isometry3<f64> {
+        let body = self.layout.base_link_body;
+        let [x, y, z] = self.data.xpos()[body];
+        let [w, i, j, k] = self.data.xquat()[body];
+        let pose = Isometry3::from_parts(
+            Translation3::new(x, y, z),
+            UnitQuaternion::from_quaternion(Quaternion::new(w, i, j, k)),
+        );
+        pose * self.layout.base_link_offset
+    }
+
+    /// Height of the `base_link` origin above the floor (m).
+    pub fn base_height(&self) -> f64 {
+        self.base_link_pose().translation.z
+    }
+
+    /// Angle between the `base_link` z axis and the world vertical (rad).
+    pub fn torso_tilt(&self) -> f64 {
+        let up = self.base_link_pose().rotation * Vector3::z();
+        up.z.clamp(-1.0, 1.0).acos()
+    }
+
+    /// Whether the robot has fallen: the base dropped below `fall_height_fraction` of its initial
+    /// height or tilted more than `fall_tilt`. Also recorded in [`SafetySummary::fell`].
+    pub fn has_fallen(&self) -> bool {
+        self.base_height() < self.options.fall_height_fraction * self.initial_base_height
+            || self.torso_tilt() > self.options.fall_tilt
+    }
+
+    /// World pose of an end-effector frame (sole or palm) in the simulator.
+    pub fn end_effector_pose(&self, effector: EndEffector) -> Isometry3<f64> {
+        let site = self.layout.effector_sites[effector as usize];
+        let position = Vector3::from(self.data.site_xpos()[site]);
+        let rotation =
+            Rotation3::from_matrix_unchecked(Matrix3::from_row_slice(&self.data.site_xmat()[site]));
+        Isometry3::from_parts(
+            Translation3::from(position),
+            UnitQuaternion::from_rotation_matrix(&rotation),
+        )
+    }
+
+    /// Advances by `dt` with the servos tracking `q_des` (clamped into the joint limits, each clamp
+    /// counted as a violation) and `qd_des`. Runs the physics steps that fit: a `dt` that is not a
+    /// multiple of the time step carries its remainder into the next call, and a call with no
+    /// step due leaves the measurement as it was.
+    pub fn step(&mut self, q_des: &[f64], qd_des: &[f64], dt: f64) -> Result<(), MujocoError> {
+        self.check_command("q_des", q_des)?;
+        self.check_command("qd_des", qd_des)?;
+        let substeps = self.substeps(dt)?;
+        let mut violations = 0;
+        let limits = self.robot.model.joint_limits();
+        let ctrl = self.data.ctrl_mut();
+        for (j, ((&q, &qd), limit)) in q_des.iter().zip(qd_des).zip(limits).enumerate() {
+            let target = q.clamp(limit.lower, limit.upper);
+            violations += usize::from(target != q);
+            ctrl[2 * j] = target;
+            ctrl[2 * j + 1] = qd;
+        }
+        let warnings_before = self.fatal_warning_count();
+        for substep in 0..substeps {
+            // Forward dynamics of the current state, the constraint solve and the integration.
+            self.data.step2();
+            if substep + 1 == substeps {
+                // The contact list, solved forces and poses still describe the same state here.
+                self.contacts = contact::read(&self.data, &self.layout.feet);
+            }
+            // Kinematics, collisions and position/velocity sensors of the new state.
+            self.data.step1();
+        }
+        if substeps == 0 {
+            return Ok(());
+        }
+        if self.fatal_warning_count() != warnings_before {
+            return Err(MujocoError::Unstable {
+                time: self.data.time(),
+            });
+        }
+        self.record(violations);
+        self.summary.steps += 1;
+        Ok(())
+    }
+
+    /// Puts the robot in `initial`, at rest, and evaluates it.
+    fn place(&mut self, initial: &Configuration) {
+        let base = &initial.base;
+        let q = base.rotation.quaternion();
+        let (base_qpos, joint_qpos) = (self.layout.base_qpos, &self.layout.joint_qpos);
+        let qpos = self.data.qpos_mut();
+        qpos[base_qpos..base_qpos + 3].copy_from_slice(base.translation.vector.as_slice());
+        qpos[base_qpos + 3..base_qpos + 7].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+        for (&address, &value) in joint_qpos.iter().zip(initial.joints.iter()) {
+            qpos[address] = value;
+        }
+        self.data.qvel_mut().fill(0.0);
+        let ctrl = self.data.ctrl_mut();
+        for (j, &value) in initial.joints.iter().enumerate() {
+            ctrl[2 * j] = value;
+            ctrl[2 * j + 1] = 0.0;
+        }
+        self.data.forward();
+        self.contacts = contact::read(&self.data, &self.layout.feet);
+        self.record(0);
+    }
+
+    /// Physics steps that bring the simulated time up to the commanded time plus `dt`
+    /// (`dt` need not be a multiple of the time step: the remainder carries over).
+    fn substeps(&mut self, dt: f64) -> Result<usize, MujocoError> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(MujocoError::BadTimeStep(dt));
+        }
+        self.commanded_time += dt;
+        let behind = (self.commanded_time - self.data.time()) / self.options.timestep;
+        // The tolerance absorbs rounding in the two accumulated clocks.
+        Ok((behind + 1e-6).floor().max(0.0) as usize)
+    }
+
+    fn check_command(&self, field: &'static str, values: &[f64]) -> Result<(), MujocoError> {
+        let expected = self.robot.model.dof();
+        if values.len() != expected {
+            return Err(MujocoError::CommandLength {
+                field,
+                expected,
+                actual: values.len(),
+            });
+        }
+        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+            let joint = self.robot.model.joint_names()[index].clone();
+            return Err(MujocoError::NonFiniteCommand {
+                field,
+                index,
+                joint,
+            });
+        }
+        Ok(())
+    }
+
+    fn fatal_warning_count(&self) -> i64 {
+        let warnings = self.data.warning();
+        FATAL_WARNINGS
+            .iter()
+            .map(|&w| i64::from(warnings[w as usize].number))
+            .sum()
+    }
+
+    /// Fills the measurement and the safety record from the evaluated state.
+    fn record(&mut self, limit_violations: usize) {
+        let qpos = self.data.qpos();
+        let qvel = self.data.qvel();
+        let m = &mut self.measurement;
+        for (j, (&qa, &da)) in self
+            .layout
+            .joint_qpos
+            .iter()
+            .zip(&self.layout.joint_dof)
+            .enumerate()
+        {
+            m.q[j] = qpos[qa];
+            m.qd[j] = qvel[da];
+        }
+        let b = self.layout.base_qpos;
+        m.base = Isometry3::from_parts(
+            Translation3::new(qpos[b], qpos[b + 1], qpos[b + 2]),
+            UnitQuaternion::from_quaternion(Quaternion::new(
+                qpos[b + 3],
+                qpos[b + 4],
+                qpos[b + 5],
+                qpos[b + 6],
+            )),
+        );
+        let s = self.data.sensordata();
+        let imu = &s[mjcf::IMU_QUAT];
+        m.base_orientation =
+            UnitQuaternion::from_quaternion(Quaternion::new(imu[0], imu[1], imu[2], imu[3]));
+        m.com = Vector3::from(self.data.subtree_com()[self.layout.base_body]);
+        m.wrenches = [[0.0; 6]; 4];
+        m.contacts = [false; 4];
+        for (slot, foot) in FEET.iter().enumerate() {
+            m.wrenches[*foot as usize] = self.contacts.wrenches[slot];
+            m.contacts[*foot as usize] = self.contacts.touching[slot];
+        }
+        let safety = self.safety(limit_violations);
+        self.measurement.safety = safety;
+        let fell = self.has_fallen();
+        let summary = &mut self.summary;
+        summary.min_stability_margin = summary.min_stability_margin.min(safety.stability_margin);
+        summary.max_contact_slip = summary.max_contact_slip.max(safety.contact_slip);
+        summary.max_penetration = summary.max_penetration.max(safety.penetration);
+        summary.joint_limit_violations += limit_violations as u64;
+        summary.fell |= fell;
+    }
+
+    /// Support-polygon margin, slip of feet in contact since touchdown, penetration.
+    fn safety(&mut self, limit_violations: usize) -> SafetyMetrics {
+        let mut corners = [[0.0; 2]; 8];
+        let mut count = 0;
+        let mut slip: f64 = 0.0;
+        for (slot, foot) in FEET.iter().enumerate() {
+            if !self.contacts.touching[slot] {
+                self.anchors[slot] = None;
+                continue;
+            }
+            let sole = self.end_effector_pose(*foot);
+            let anchor = *self.anchors[slot].get_or_insert(sole);
+            slip = slip.max(
+                (sole.translation.vector - anchor.translation.vector)
+                    .xy()
+                    .norm(),
+            );
+            for corner in sole_corners(&sole, &self.robot.sole) {
+                corners[count] = [corner.x, corner.y];
+                count += 1;
+            }
+        }
+        self.polygon.set_hull(&corners[..count]);
+        let com = self.measurement.com;
+        SafetyMetrics {
+            stability_margin: self.polygon.signed_distance([com.x, com.y]),
+            contact_slip: slip,
+            penetration: self.contacts.penetration,
+            limit_violations,
+        }
+    }
+}
+
+impl Layout {
+    fn resolve(model: &MjModel, robot: &Robot, bodies: &RigidBodies) -> Result<Self, MujocoError> {
+        let id = |kind: MjtObjBase, name: &str| {
+            model.name_to_id(kind, name).ok_or_else(|| {
+                MujocoError::Compile(format!(
+                    "the generated model has no {kind:?} named '{name}'"
+                ))
+            })
+        };
+        let qpos_addresses = model.jnt_qposadr();
+        let dof_addresses = model.jnt_dofadr();
+        let mut joint_qpos = Vec::with_capacity(robot.model.dof());
+        let mut joint_dof = Vec::with_capacity(robot.model.dof());
+        for name in robot.model.joint_names() {
+            let joint = id(MjtObjBase::mjOBJ_JOINT, name)?;
+            joint_qpos.push(qpos_addresses[joint] as usize);
+            joint_dof.push(dof_addresses[joint] as usize);
+        }
+        let free = id(MjtObjBase::mjOBJ_JOINT, mjcf::FREE_JOINT)?;
+        let base_body = id(MjtObjBase::mjOBJ_BODY, &bodies.bodies[0].name)?;
+        let mut effector_sites = [0; 4];
+        for effector in EndEffector::ALL {
+            effector_sites[effector as usize] =
+                id(MjtObjBase::mjOBJ_SITE, mjcf::end_effector_site(effector))?;
+        }
+        let feet = FootIds {
+            geoms: [
+                id(MjtObjBase::mjOBJ_GEOM, mjcf::FOOT_GEOMS[0])?,
+                id(MjtObjBase::mjOBJ_GEOM, mjcf::FOOT_GEOMS[1])?,
+            ],
+            ft_sites: [
+                id(MjtObjBase::mjOBJ_SITE, mjcf::FT_SITES[0])?,
+                id(MjtObjBase::mjOBJ_SITE, mjcf::FT_SITES[1])?,
+            ],
+        };
+        let base_link_name = robot.model.link_name(robot.base_link);
+        let base_link = bodies.links.get(base_link_name).ok_or_else(|| {
+            MujocoError::ModelMismatch(format!(
+                "base link '{base_link_name}' is not a link of the URDF"
+            ))
+        })?;
+        Ok(Self {
+            joint_qpos,
+            joint_dof,
+            base_body,
+            base_qpos: qpos_addresses[free] as usize,
+            effector_sites,
+            feet,
+            base_link_body: id(MjtObjBase::mjOBJ_BODY, &bodies.bodies[base_link.body].name)?,
+            base_link_offset: base_link.offset,
+        })
+    }
+}
+
+fn check_library_version() -> Result<(), MujocoError> {
+    let found = mujoco_rs::mujoco_version();
+    if found != MUJOCO_VERSION {
+        return Err(MujocoError::LibraryVersion {
+            found: found.to_owned(),
+            expected: MUJOCO_VERSION,
+        });
+    }
+    Ok(())
+}
+
+fn check_options(options: &MujocoOptions) -> Result<(), MujocoError> {
+    let o = options;
+    let positive = [
+        ("timestep", o.timestep),
+        ("servo_stiffness", o.servo_stiffness),
+        ("sole_thickness", o.sole_thickness),
+        ("contact_time_constant", o.contact_time_constant),
+        ("fall_tilt", o.fall_tilt),
+    ];
+    let non_negative = [
+        ("servo_damping", o.servo_damping),
+        ("armature", o.armature),
+        ("joint_damping", o.joint_damping),
+        ("friction", o.friction),
+        ("fall_height_fraction", o.fall_height_fraction),
+    ];
+    for (name, value) in positive {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(MujocoError::BadOption {
+                name,
+                value,
+                requirement: "positive and finite",
+            });
+        }
+    }
+    for (name, value) in non_negative {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(MujocoError::BadOption {
+                name,
+                value,
+                requirement: "non-negative and finite",
+            });
+        }
+    }
+    if o.contact_time_constant < 2.0 * o.timestep {
+        return Err(MujocoError::BadOption {
+            name: "contact_time_constant",
+            value: o.contact_time_constant,
+            requirement: "at least twice the timestep",
+        });
+    }
+    Ok(())
+}
