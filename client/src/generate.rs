@@ -1,0 +1,79 @@
+//! `walkctl generate`: a human-like, impeded raw stance sequence for a robot (the stance source
+//! until an n-gram generator exists).
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use stance::{AffordanceSet, GenerateOptions, generate_with_railing};
+
+use crate::postprocess::{ParamOverrides, load_robot};
+
+/// Arguments of `walkctl generate`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct GenerateArgs {
+    /// Robot config (TOML with `[robot]` and `[postprocess]`), e.g. configs/armar4.toml.
+    #[arg(long, value_name = "CONFIG")]
+    pub robot: PathBuf,
+    /// URDF to use instead of the config's `urdf` (required for HRP-4).
+    #[arg(long, value_name = "PATH")]
+    pub urdf: Option<PathBuf>,
+    /// Distance the post-processed walk should cover [m]; the raw sequence is generated for
+    /// D / scf (the paper's rule), with scf from `[postprocess]` or `--scf`.
+    #[arg(long, value_name = "D")]
+    pub distance: f64,
+    /// Generate exactly D metres (no division by scf).
+    #[arg(long)]
+    pub raw_distance: bool,
+    /// Support affordances: feet, feet+left-hand or feet+right-hand (a railing along the path).
+    #[arg(long, default_value = "feet", value_name = "SET")]
+    pub affordances: AffordanceSet,
+    /// Part of the (post-processed) path where the railing may be held, `FROM:TO` in metres;
+    /// scaled by 1 / scf like the distance. Default: the whole walk.
+    #[arg(long, value_name = "FROM:TO", value_parser = parse_interval)]
+    pub railing: Option<[f64; 2]>,
+    /// Seed of the deterministic random source.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Where to write the raw stance file.
+    #[arg(short, long, value_name = "RAW.json")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub params: ParamOverrides,
+}
+
+fn parse_interval(text: &str) -> Result<[f64; 2], String> {
+    let (from, to) = text.split_once(':').ok_or("expected FROM:TO, e.g. 0:2.5")?;
+    let parse = |s: &str| s.trim().parse::<f64>().map_err(|e| format!("`{s}`: {e}"));
+    Ok([parse(from)?, parse(to)?])
+}
+
+/// Runs `walkctl generate`.
+pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
+    let robot = load_robot(&args.robot, args.urdf.as_deref())?;
+    let scale = if args.raw_distance {
+        1.0
+    } else {
+        1.0 / args.params.load(&args.robot)?.scf
+    };
+    let distance = args.distance * scale;
+    let railing = args
+        .railing
+        .unwrap_or([0.0, args.distance])
+        .map(|s| s * scale);
+    let options = GenerateOptions {
+        distance,
+        affordances: args.affordances,
+        seed: args.seed,
+    };
+    let raw = generate_with_railing(&robot, &options, railing)?;
+    std::fs::write(&args.output, raw.to_json_string())
+        .with_context(|| format!("writing {}", args.output.display()))?;
+    eprintln!(
+        "{}: {} stances, {distance:.2} m raw, affordances {}, seed {}",
+        args.output.display(),
+        raw.len(),
+        args.affordances,
+        args.seed
+    );
+    Ok(())
+}

@@ -1,0 +1,148 @@
+//! The environment a sequence is planned in: planar support surfaces for the feet and hand
+//! affordances (e.g. a railing) with the interval of the path along which they are available.
+
+use nalgebra::{Isometry3, Point3, Vector3};
+
+/// A planar support surface: its frame (z = surface normal, the plane is its xy plane) and the
+/// polygon of the supporting area in that plane. `polygon: None` is an unbounded plane (the
+/// ground).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SupportSurface {
+    /// Name used in messages and files (e.g. `"ground"`).
+    pub name: String,
+    /// Surface frame in the world.
+    pub pose: Isometry3<f64>,
+    /// Vertices `[x, y]` of the supporting area in the surface frame, or `None` for no bound.
+    pub polygon: Option<Vec<[f64; 2]>>,
+}
+
+impl SupportSurface {
+    /// The default environment's ground: the unbounded plane z = 0.
+    pub fn ground() -> Self {
+        Self {
+            name: "ground".to_owned(),
+            pose: Isometry3::identity(),
+            polygon: None,
+        }
+    }
+
+    /// Elevation (world z) of the surface vertically below/above the world point `(x, y)`;
+    /// `None` if that point projects outside the polygon or the surface is vertical.
+    pub fn elevation_at(&self, x: f64, y: f64) -> Option<f64> {
+        let normal = self.pose.rotation * Vector3::z();
+        if normal.z.abs() < 1e-9 {
+            return None;
+        }
+        let origin = self.pose.translation.vector;
+        // n · (p − o) = 0 with p = (x, y, z) solved for z.
+        let z = origin.z - (normal.x * (x - origin.x) + normal.y * (y - origin.y)) / normal.z;
+        let Some(polygon) = &self.polygon else {
+            return Some(z);
+        };
+        let local = self.pose.inverse_transform_point(&Point3::new(x, y, z));
+        polygon_contains(polygon, local.x, local.y).then_some(z)
+    }
+}
+
+/// Even-odd ray casting test of `(x, y)` against a closed polygon.
+fn polygon_contains(polygon: &[[f64; 2]], x: f64, y: f64) -> bool {
+    let mut inside = false;
+    let mut previous = polygon[polygon.len() - 1];
+    for &vertex in polygon {
+        let ([xi, yi], [xj, yj]) = (vertex, previous);
+        if (yi > y) != (yj > y) && x < (xj - xi) * (y - yi) / (yj - yi) + xi {
+            inside = !inside;
+        }
+        previous = vertex;
+    }
+    inside
+}
+
+/// A hand affordance along the path, e.g. a railing: a straight segment the hands may hold,
+/// usable while the walker is inside `available` (metres along the walking path).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HandAffordance {
+    /// Name used in messages and files (e.g. `"railing"`).
+    pub name: String,
+    /// First end of the segment in the world.
+    pub start: Vector3<f64>,
+    /// Second end of the segment in the world.
+    pub end: Vector3<f64>,
+    /// `[from, to]`: the part of the path (metres from its origin) where the affordance may be used.
+    pub available: [f64; 2],
+}
+
+/// Support surfaces and hand affordances of a sequence.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Environment {
+    /// Surfaces the feet may stand on (at least one).
+    pub surfaces: Vec<SupportSurface>,
+    /// Surfaces/objects the hands may hold.
+    pub hand_affordances: Vec<HandAffordance>,
+}
+
+impl Default for Environment {
+    /// The ground plane z = 0 and no hand affordance.
+    fn default() -> Self {
+        Self {
+            surfaces: vec![SupportSurface::ground()],
+            hand_affordances: Vec::new(),
+        }
+    }
+}
+
+impl Environment {
+    /// The surface a point belongs to and its elevation there: of the surfaces under or above the
+    /// point, the one vertically nearest. `None` if no surface covers the point's `(x, y)`.
+    pub fn support_at(&self, point: &Vector3<f64>) -> Option<(&SupportSurface, f64)> {
+        self.surfaces
+            .iter()
+            .filter_map(|s| s.elevation_at(point.x, point.y).map(|z| (s, z)))
+            .min_by(|(_, a), (_, b)| (point.z - a).abs().total_cmp(&(point.z - b).abs()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::UnitQuaternion;
+
+    #[test]
+    fn ground_is_everywhere_at_zero() {
+        let env = Environment::default();
+        let (surface, z) = env.support_at(&Vector3::new(12.0, -3.0, -0.4)).unwrap();
+        assert_eq!(surface.name, "ground");
+        assert_eq!(z, 0.0);
+    }
+
+    #[test]
+    fn nearest_surface_wins_inside_its_polygon() {
+        let step = SupportSurface {
+            name: "step".into(),
+            pose: Isometry3::translation(1.0, 0.0, 0.2),
+            polygon: Some(vec![[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]]),
+        };
+        let env = Environment {
+            surfaces: vec![SupportSurface::ground(), step],
+            hand_affordances: Vec::new(),
+        };
+        let (on_step, z) = env.support_at(&Vector3::new(1.2, 0.1, 0.17)).unwrap();
+        assert_eq!((on_step.name.as_str(), z), ("step", 0.2));
+        let (outside, z) = env.support_at(&Vector3::new(1.7, 0.1, 0.17)).unwrap();
+        assert_eq!((outside.name.as_str(), z), ("ground", 0.0));
+    }
+
+    #[test]
+    fn tilted_surface_elevation_follows_the_plane() {
+        let ramp = SupportSurface {
+            name: "ramp".into(),
+            pose: Isometry3::from_parts(
+                Vector3::new(0.0, 0.0, 0.1).into(),
+                UnitQuaternion::from_euler_angles(0.0, -0.1, 0.0),
+            ),
+            polygon: None,
+        };
+        let z = ramp.elevation_at(1.0, 5.0).unwrap();
+        assert!((z - (0.1 + 0.1f64.tan())).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,424 @@
+//! The versioned JSON stance file (DESIGN.md §3) and its strict reader.
+//!
+//! ```json
+//! { "format_version": 1, "kind": "raw" | "post_processed", "robot": "armar4",
+//!   "joint_names": ["..."],
+//!   "environment": { "surfaces": [{ "name": "ground",
+//!                                   "pose": { "translation": [0, 0, 0], "rotation": [0, 0, 0, 1] },
+//!                                   "polygon": null }],
+//!                    "hand_affordances": [{ "name": "railing", "start": [..], "end": [..],
+//!                                           "available": [0.0, 5.0] }] },
+//!   "stances": [{ "q": [..], "contacts": ["left_foot", "right_foot"],
+//!                 "translation": [x, y, z], "root_orientation": [x, y, z, w],
+//!                 "targets": { "left_foot": { "translation": [..], "rotation": [..] }, .. } }] }
+//! ```
+//! `targets` is present exactly in post-processed files; `root_orientation` defaults to the
+//! identity. Unknown fields are errors. Quaternions are `[x, y, z, w]`.
+
+use kinematics::robot::{EndEffector, Robot};
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+
+use crate::environment::{Environment, HandAffordance, SupportSurface};
+use crate::error::{FormatError, Location};
+use crate::json_path::{location_at, offset_of};
+use crate::sequence::{PostProcessedSequence, RawSequence, Stance};
+
+/// The file format version this build writes and reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+#[derive(Serialize, Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
+#[serde(rename_all = "snake_case")]
+enum Kind {
+    Raw,
+    PostProcessed,
+}
+
+impl Kind {
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Raw => "raw",
+            Kind::PostProcessed => "post_processed",
+        }
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileDto {
+    format_version: u64,
+    kind: Kind,
+    robot: String,
+    joint_names: Vec<String>,
+    environment: EnvironmentDto,
+    stances: Vec<StanceDto>,
+}
+
+#[derive(Deserialize)]
+struct VersionProbe {
+    format_version: u64,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StanceDto {
+    q: Vec<f64>,
+    contacts: Vec<String>,
+    translation: [f64; 3],
+    #[serde(default)]
+    root_orientation: Option<[f64; 4]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    targets: Option<TargetsDto>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TargetsDto {
+    left_foot: PoseDto,
+    right_foot: PoseDto,
+    left_hand: PoseDto,
+    right_hand: PoseDto,
+}
+
+#[derive(Serialize, Deserialize, Clone, Copy)]
+#[serde(deny_unknown_fields)]
+struct PoseDto {
+    translation: [f64; 3],
+    rotation: [f64; 4],
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EnvironmentDto {
+    surfaces: Vec<SurfaceDto>,
+    #[serde(default)]
+    hand_affordances: Vec<HandAffordanceDto>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SurfaceDto {
+    name: String,
+    pose: PoseDto,
+    #[serde(default)]
+    polygon: Option<Vec<[f64; 2]>>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HandAffordanceDto {
+    name: String,
+    start: [f64; 3],
+    end: [f64; 3],
+    available: [f64; 2],
+}
+
+fn quaternion(xyzw: [f64; 4]) -> UnitQuaternion<f64> {
+    // Unchecked on purpose: the validator reports a non-unit norm with its location.
+    UnitQuaternion::new_unchecked(Quaternion::new(xyzw[3], xyzw[0], xyzw[1], xyzw[2]))
+}
+
+fn xyzw(rotation: &UnitQuaternion<f64>) -> [f64; 4] {
+    let c = rotation.coords;
+    [c.x, c.y, c.z, c.w]
+}
+
+impl From<PoseDto> for Isometry3<f64> {
+    fn from(pose: PoseDto) -> Self {
+        Isometry3::from_parts(
+            Translation3::from(Vector3::from(pose.translation)),
+            quaternion(pose.rotation),
+        )
+    }
+}
+
+impl From<&Isometry3<f64>> for PoseDto {
+    fn from(pose: &Isometry3<f64>) -> Self {
+        PoseDto {
+            translation: pose.translation.vector.into(),
+            rotation: xyzw(&pose.rotation),
+        }
+    }
+}
+
+impl From<EnvironmentDto> for Environment {
+    fn from(dto: EnvironmentDto) -> Self {
+        Environment {
+            surfaces: dto
+                .surfaces
+                .into_iter()
+                .map(|s| SupportSurface {
+                    name: s.name,
+                    pose: s.pose.into(),
+                    polygon: s.polygon,
+                })
+                .collect(),
+            hand_affordances: dto
+                .hand_affordances
+                .into_iter()
+                .map(|h| HandAffordance {
+                    name: h.name,
+                    start: h.start.into(),
+                    end: h.end.into(),
+                    available: h.available,
+                })
+                .collect(),
+        }
+    }
+}
+
+impl From<&Environment> for EnvironmentDto {
+    fn from(env: &Environment) -> Self {
+        EnvironmentDto {
+            surfaces: env
+                .surfaces
+                .iter()
+                .map(|s| SurfaceDto {
+                    name: s.name.clone(),
+                    pose: (&s.pose).into(),
+                    polygon: s.polygon.clone(),
+                })
+                .collect(),
+            hand_affordances: env
+                .hand_affordances
+                .iter()
+                .map(|h| HandAffordanceDto {
+                    name: h.name.clone(),
+                    start: h.start.into(),
+                    end: h.end.into(),
+                    available: h.available,
+                })
+                .collect(),
+        }
+    }
+}
+
+fn contact_flags(stance: usize, names: &[String]) -> Result<[bool; 4], FormatError> {
+    let mut flags = [false; 4];
+    for name in names {
+        let e = EndEffector::ALL
+            .into_iter()
+            .find(|e| e.name() == name)
+            .filter(|e| !flags[*e as usize])
+            .ok_or_else(|| FormatError::BadContact {
+                stance,
+                name: name.clone(),
+            })?;
+        flags[e as usize] = true;
+    }
+    Ok(flags)
+}
+
+fn contact_names(flags: &[bool; 4]) -> Vec<String> {
+    EndEffector::ALL
+        .into_iter()
+        .filter(|e| flags[*e as usize])
+        .map(|e| e.name().to_owned())
+        .collect()
+}
+
+/// The value token around byte `offset`: from the last delimiter before it to the next one.
+fn token_at(text: &str, offset: usize) -> &str {
+    let delimiter = |c: char| c.is_whitespace() || matches!(c, ',' | ':' | '[' | ']' | '{' | '}');
+    let offset = offset.min(text.len());
+    let start = text[..offset].rfind(delimiter).map_or(0, |i| i + 1);
+    let end = text[offset..]
+        .find(delimiter)
+        .map_or(text.len(), |i| offset + i);
+    &text[start..end]
+}
+
+/// Whether a token is one of the non-JSON spellings of NaN or an infinity.
+fn is_non_finite_literal(token: &str) -> bool {
+    let unsigned = token.trim_start_matches(['-', '+']);
+    ["nan", "inf", "infinity"]
+        .iter()
+        .any(|t| unsigned.eq_ignore_ascii_case(t))
+}
+
+/// Maps a serde_json error to a located [`FormatError`].
+fn json_error(text: &str, error: serde_json::Error) -> FormatError {
+    let (line, column) = (error.line(), error.column());
+    let offset = offset_of(text, line, column);
+    let location = location_at(text, offset);
+    let message = error.to_string();
+    let non_finite =
+        message.contains("number out of range") || is_non_finite_literal(token_at(text, offset));
+    match error.classify() {
+        serde_json::error::Category::Eof => FormatError::Truncated {
+            line,
+            column,
+            location,
+        },
+        _ if non_finite => FormatError::NonFinite { location },
+        serde_json::error::Category::Data => FormatError::Structure {
+            line,
+            column,
+            location,
+            // serde_json appends " at line L column C"; the location already says it.
+            message: message
+                .rsplit_once(" at line ")
+                .map_or(message.as_str(), |(m, _)| m)
+                .to_owned(),
+        },
+        _ => FormatError::Syntax {
+            line,
+            column,
+            location,
+            message,
+        },
+    }
+}
+
+fn parse_file(text: &str, expected: Kind) -> Result<FileDto, FormatError> {
+    let file: FileDto = serde_json::from_str(text).map_err(|error| {
+        match serde_json::from_str::<VersionProbe>(text) {
+            Ok(probe) if probe.format_version != u64::from(FORMAT_VERSION) => {
+                FormatError::UnsupportedVersion {
+                    found: probe.format_version,
+                    supported: FORMAT_VERSION,
+                }
+            }
+            _ => json_error(text, error),
+        }
+    })?;
+    if file.format_version != u64::from(FORMAT_VERSION) {
+        return Err(FormatError::UnsupportedVersion {
+            found: file.format_version,
+            supported: FORMAT_VERSION,
+        });
+    }
+    if file.kind != expected {
+        return Err(FormatError::WrongKind {
+            expected: expected.name(),
+            found: file.kind.name(),
+        });
+    }
+    Ok(file)
+}
+
+type Parts = (String, Vec<String>, Environment, Vec<Stance>);
+
+fn into_parts(file: FileDto) -> Result<(Parts, Vec<Option<TargetsDto>>), FormatError> {
+    let mut stances = Vec::with_capacity(file.stances.len());
+    let mut targets = Vec::with_capacity(file.stances.len());
+    for (i, dto) in file.stances.into_iter().enumerate() {
+        stances.push(Stance {
+            q: dto.q,
+            contacts: contact_flags(i, &dto.contacts)?,
+            translation: dto.translation.into(),
+            root_orientation: dto
+                .root_orientation
+                .map_or_else(UnitQuaternion::identity, quaternion),
+        });
+        targets.push(dto.targets);
+    }
+    let parts = (
+        file.robot,
+        file.joint_names,
+        file.environment.into(),
+        stances,
+    );
+    Ok((parts, targets))
+}
+
+fn stance_dto(stance: &Stance, targets: Option<&[Isometry3<f64>; 4]>) -> StanceDto {
+    let identity = stance.root_orientation == UnitQuaternion::identity();
+    StanceDto {
+        q: stance.q.clone(),
+        contacts: contact_names(&stance.contacts),
+        translation: stance.translation.into(),
+        root_orientation: (!identity).then(|| xyzw(&stance.root_orientation)),
+        targets: targets.map(|t| TargetsDto {
+            left_foot: (&t[EndEffector::LeftFoot as usize]).into(),
+            right_foot: (&t[EndEffector::RightFoot as usize]).into(),
+            left_hand: (&t[EndEffector::LeftHand as usize]).into(),
+            right_hand: (&t[EndEffector::RightHand as usize]).into(),
+        }),
+    }
+}
+
+fn write(file: &FileDto) -> String {
+    serde_json::to_string_pretty(file).expect("a stance file always serialises")
+}
+
+impl RawSequence {
+    /// Reads and validates a raw stance file without checking it against a robot.
+    pub fn parse_json_str(text: &str) -> Result<Self, FormatError> {
+        let (parts, targets) = into_parts(parse_file(text, Kind::Raw)?)?;
+        if let Some(i) = targets.iter().position(Option::is_some) {
+            return Err(FormatError::Invalid {
+                location: Location::stance(i, "targets"),
+                message: "a raw stance has no targets (is this a post-processed file?)".into(),
+            });
+        }
+        let (robot, joint_names, environment, stances) = parts;
+        RawSequence::new(robot, joint_names, environment, stances)
+    }
+
+    /// Reads a raw stance file and checks that it is for `robot` (name, joint names and order).
+    pub fn from_json_str(text: &str, robot: &Robot) -> Result<Self, FormatError> {
+        let sequence = Self::parse_json_str(text)?;
+        sequence.check_robot(robot)?;
+        Ok(sequence)
+    }
+
+    /// The sequence as a (pretty-printed) stance file.
+    pub fn to_json_string(&self) -> String {
+        write(&FileDto {
+            format_version: FORMAT_VERSION.into(),
+            kind: Kind::Raw,
+            robot: self.robot.clone(),
+            joint_names: self.joint_names.clone(),
+            environment: (&self.environment).into(),
+            stances: self.stances.iter().map(|s| stance_dto(s, None)).collect(),
+        })
+    }
+}
+
+impl PostProcessedSequence {
+    /// Reads and validates a post-processed stance file without checking it against a robot.
+    pub fn parse_json_str(text: &str) -> Result<Self, FormatError> {
+        let (parts, targets) = into_parts(parse_file(text, Kind::PostProcessed)?)?;
+        let targets = targets
+            .into_iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let t = t.ok_or_else(|| FormatError::Invalid {
+                    location: Location::stance(i, "targets"),
+                    message:
+                        "missing: a post-processed stance needs targets for all four end-effectors"
+                            .into(),
+                })?;
+                Ok([t.left_foot, t.right_foot, t.left_hand, t.right_hand].map(Isometry3::from))
+            })
+            .collect::<Result<Vec<_>, FormatError>>()?;
+        let (robot, joint_names, environment, stances) = parts;
+        PostProcessedSequence::new(robot, joint_names, environment, stances, targets)
+    }
+
+    /// Reads a post-processed stance file and checks that it is for `robot`. This is the
+    /// validator a daemon applies to sequences it receives as JSON bytes.
+    pub fn from_json_str(text: &str, robot: &Robot) -> Result<Self, FormatError> {
+        let sequence = Self::parse_json_str(text)?;
+        sequence.check_robot(robot)?;
+        Ok(sequence)
+    }
+
+    /// The sequence as a (pretty-printed) stance file.
+    pub fn to_json_string(&self) -> String {
+        write(&FileDto {
+            format_version: FORMAT_VERSION.into(),
+            kind: Kind::PostProcessed,
+            robot: self.robot.clone(),
+            joint_names: self.joint_names.clone(),
+            environment: (&self.environment).into(),
+            stances: self
+                .stances
+                .iter()
+                .zip(&self.targets)
+                .map(|(s, t)| stance_dto(s, Some(t)))
+                .collect(),
+        })
+    }
+}

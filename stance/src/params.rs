@@ -1,0 +1,192 @@
+//! Algorithm 1's parameters: the `[postprocess]` section of a robot config.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+/// How a run of contacts of one end-effector is made static (pass 2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactUnification {
+    /// Every stance of the run takes the run's first contact pose (the paper's choice).
+    #[default]
+    First,
+    /// Every stance of the run takes the mean of the run's poses (the interpolation variant).
+    Mean,
+}
+
+/// Parameters of Algorithm 1 (names as in the paper). Lengths in metres, angles in radians.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PostProcessParams {
+    /// Sequence scaling factor `scf` ∈ (0, 1]: along-path displacements are multiplied by it.
+    pub scf: f64,
+    /// Maximal step size `s_max` (along-path distance between consecutive contacts of one foot).
+    pub s_max: f64,
+    /// Minimal orthogonal (lateral) distance between the feet centres `o_min`.
+    pub o_min: f64,
+    /// Maximal orthogonal (lateral) distance between the feet centres `o_max`.
+    pub o_max: f64,
+    /// Swing-foot roll limit `α_x` (relative to its surface).
+    pub alpha_x: f64,
+    /// Swing-foot pitch limit `α_y` (relative to its surface).
+    pub alpha_y: f64,
+    /// Swing-foot yaw limit `α_z` (relative to the walking direction).
+    pub alpha_z: f64,
+    /// Minimal swing-foot height above its surface `h_min`.
+    pub h_min: f64,
+    /// Maximal swing-foot height above its surface `h_max`.
+    pub h_max: f64,
+    /// Pass 2 variant; `first` unless the config says `contact_unification = "mean"`.
+    #[serde(default)]
+    pub contact_unification: ContactUnification,
+}
+
+/// Why the `[postprocess]` section could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ParamsError {
+    /// The config file could not be read.
+    #[error("{path}: cannot read: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The config file is not TOML.
+    #[error("{path}: invalid TOML: {source}")]
+    Toml {
+        path: PathBuf,
+        source: toml::de::Error,
+    },
+    /// No `[postprocess]` table.
+    #[error("{path}: missing section [postprocess]")]
+    MissingSection { path: PathBuf },
+    /// A missing, unknown or mistyped key in `[postprocess]`.
+    #[error("{path}: [postprocess]: {message}")]
+    Key { path: PathBuf, message: String },
+    /// A value outside its domain.
+    #[error("{origin}: [postprocess] key `{key}`: {message}")]
+    Invalid {
+        origin: String,
+        key: &'static str,
+        message: String,
+    },
+}
+
+impl PostProcessParams {
+    /// Reads the `[postprocess]` section of the robot config at `path`.
+    pub fn from_config_path(path: &Path) -> Result<Self, ParamsError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ParamsError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::from_config_str(&text, path)
+    }
+
+    /// Reads the `[postprocess]` section of a robot config's text (`path` names it in errors).
+    pub fn from_config_str(text: &str, path: &Path) -> Result<Self, ParamsError> {
+        let table: toml::Table = toml::from_str(text).map_err(|source| ParamsError::Toml {
+            path: path.to_owned(),
+            source,
+        })?;
+        let section = table
+            .get("postprocess")
+            .ok_or_else(|| ParamsError::MissingSection {
+                path: path.to_owned(),
+            })?
+            .clone();
+        let params: Self = section
+            .try_into()
+            .map_err(|e: toml::de::Error| ParamsError::Key {
+                path: path.to_owned(),
+                message: e.message().to_owned(),
+            })?;
+        params.validate(&path.display().to_string())?;
+        Ok(params)
+    }
+
+    /// Checks every value's domain; `origin` names the source in the error (file or "--option").
+    pub fn validate(&self, origin: &str) -> Result<(), ParamsError> {
+        let invalid = |key: &'static str, message: &str| {
+            Err(ParamsError::Invalid {
+                origin: origin.to_owned(),
+                key,
+                message: message.to_owned(),
+            })
+        };
+        let all = [
+            ("scf", self.scf),
+            ("s_max", self.s_max),
+            ("o_min", self.o_min),
+            ("o_max", self.o_max),
+            ("alpha_x", self.alpha_x),
+            ("alpha_y", self.alpha_y),
+            ("alpha_z", self.alpha_z),
+            ("h_min", self.h_min),
+            ("h_max", self.h_max),
+        ];
+        if let Some((key, _)) = all.iter().find(|(_, v)| !v.is_finite() || *v < 0.0) {
+            return invalid(key, "must be a finite number ≥ 0");
+        }
+        if self.scf <= 0.0 || self.scf > 1.0 {
+            return invalid("scf", "must be in (0, 1]");
+        }
+        if self.s_max <= 0.0 {
+            return invalid("s_max", "must be > 0");
+        }
+        if self.o_min > self.o_max {
+            return invalid("o_min", "must not exceed o_max");
+        }
+        if self.h_min > self.h_max {
+            return invalid("h_min", "must not exceed h_max");
+        }
+        let right_angle = std::f64::consts::FRAC_PI_2;
+        for (key, alpha) in [
+            ("alpha_x", self.alpha_x),
+            ("alpha_y", self.alpha_y),
+            ("alpha_z", self.alpha_z),
+        ] {
+            if alpha >= right_angle {
+                return invalid(key, "must be below π/2");
+            }
+        }
+        Ok(())
+    }
+
+    /// The swing-foot rotation limits `[α_x, α_y, α_z]`.
+    pub fn alpha(&self) -> [f64; 3] {
+        [self.alpha_x, self.alpha_y, self.alpha_z]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SECTION: &str = "[postprocess]\nscf = 0.4\ns_max = 0.3\no_min = 0.18\no_max = 0.3\n\
+        alpha_x = 0.1\nalpha_y = 0.2\nalpha_z = 0.3\nh_min = 0.03\nh_max = 0.1\n";
+
+    #[test]
+    fn reads_the_section() {
+        let p = PostProcessParams::from_config_str(SECTION, Path::new("r.toml")).unwrap();
+        assert_eq!((p.scf, p.h_max), (0.4, 0.1));
+        assert_eq!(p.contact_unification, ContactUnification::First);
+    }
+
+    #[test]
+    fn typo_names_file_and_key() {
+        let text = SECTION.replace("s_max", "smax");
+        let err = PostProcessParams::from_config_str(&text, Path::new("r.toml")).unwrap_err();
+        let message = err.to_string();
+        assert!(
+            message.contains("r.toml") && message.contains("smax"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn out_of_domain_value_is_refused() {
+        let text = SECTION.replace("scf = 0.4", "scf = 1.5");
+        let err = PostProcessParams::from_config_str(&text, Path::new("r.toml")).unwrap_err();
+        assert!(err.to_string().contains("`scf`"), "{err}");
+    }
+}

@@ -1,0 +1,229 @@
+//! Algorithm 1: the nine post-processing passes (DESIGN.md §4), each a function on a
+//! [`PoseSequence`], and [`run_passes`], which composes them in the paper's order.
+
+mod contacts;
+mod elevation;
+mod height;
+mod orientation;
+mod path;
+
+pub use contacts::unify_contacts;
+pub use elevation::{contact_feet_to_surface_elevation, move_stances_up};
+pub use height::limit_swing_foot_height;
+pub use orientation::{contact_feet_parallel_to_surface, limit_swing_foot_rotation};
+pub use path::{limit_orthogonal_feet_distance, limit_to_max_step_size, scale_translation};
+
+use crate::environment::Environment;
+use crate::geometry::PathFrame;
+use crate::params::PostProcessParams;
+use crate::poses::{FEET, PoseSequence};
+
+/// The passes of Algorithm 1 in execution order (lines 2–10).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pass {
+    /// Line 2, [`move_stances_up`].
+    MoveStancesUp,
+    /// Line 3, [`unify_contacts`].
+    UnifyContacts,
+    /// Line 4, [`contact_feet_parallel_to_surface`].
+    ContactFeetParallelToSurface,
+    /// Line 5, [`contact_feet_to_surface_elevation`].
+    ContactFeetToSurfaceElevation,
+    /// Line 6, [`limit_swing_foot_rotation`].
+    LimitSwingFootRotation,
+    /// Line 7, [`scale_translation`].
+    ScaleTranslation,
+    /// Line 8, [`limit_to_max_step_size`].
+    LimitToMaxStepSize,
+    /// Line 9, [`limit_orthogonal_feet_distance`].
+    LimitOrthogonalFeetDistance,
+    /// Line 10, [`limit_swing_foot_height`].
+    LimitSwingFootHeight,
+}
+
+impl Pass {
+    /// All passes in order.
+    pub const ALL: [Pass; 9] = [
+        Pass::MoveStancesUp,
+        Pass::UnifyContacts,
+        Pass::ContactFeetParallelToSurface,
+        Pass::ContactFeetToSurfaceElevation,
+        Pass::LimitSwingFootRotation,
+        Pass::ScaleTranslation,
+        Pass::LimitToMaxStepSize,
+        Pass::LimitOrthogonalFeetDistance,
+        Pass::LimitSwingFootHeight,
+    ];
+
+    /// The paper's name of the pass.
+    pub fn name(self) -> &'static str {
+        match self {
+            Pass::MoveStancesUp => "moveStancesUp",
+            Pass::UnifyContacts => "unifyContacts",
+            Pass::ContactFeetParallelToSurface => "contactFeetParallelToGroundSurface",
+            Pass::ContactFeetToSurfaceElevation => "contactFeetToSurfaceElevation",
+            Pass::LimitSwingFootRotation => "limitSwingFootRotation",
+            Pass::ScaleTranslation => "scaleTranslation",
+            Pass::LimitToMaxStepSize => "limitToMaxStepSize",
+            Pass::LimitOrthogonalFeetDistance => "limitOrthogonalFeetDistance",
+            Pass::LimitSwingFootHeight => "limitSwingFootHeight",
+        }
+    }
+
+    /// Line of Algorithm 1 that runs the pass.
+    pub fn line(self) -> usize {
+        self as usize + 2
+    }
+}
+
+/// The walking path of a pose sequence (see [`PathFrame`]): from the first root along the mean
+/// heading of every contact foot pose; `None` when empty.
+pub fn path_of(poses: &PoseSequence) -> Option<PathFrame> {
+    let origin = poses.roots.first()?.translation.vector;
+    let contact_feet = (0..poses.len()).flat_map(|i| {
+        FEET.iter()
+            .filter(move |&&foot| poses.in_contact(i, foot))
+            .map(move |&foot| poses.pose(i, foot))
+    });
+    Some(PathFrame::of_walk(&origin, contact_feet))
+}
+
+/// Runs the nine passes in order on `poses`. Allocation-free.
+pub fn run_passes(poses: &mut PoseSequence, environment: &Environment, params: &PostProcessParams) {
+    run_passes_observed(poses, environment, params, |_, _| {});
+}
+
+/// [`run_passes`], calling `after` with each pass and the poses it produced (for Fig. 3).
+pub fn run_passes_observed(
+    poses: &mut PoseSequence,
+    environment: &Environment,
+    params: &PostProcessParams,
+    mut after: impl FnMut(Pass, &PoseSequence),
+) {
+    if poses.is_empty() {
+        return;
+    }
+    move_stances_up(poses, environment);
+    after(Pass::MoveStancesUp, poses);
+    unify_contacts(poses, params.contact_unification);
+    after(Pass::UnifyContacts, poses);
+    contact_feet_parallel_to_surface(poses, environment);
+    after(Pass::ContactFeetParallelToSurface, poses);
+    contact_feet_to_surface_elevation(poses, environment);
+    after(Pass::ContactFeetToSurfaceElevation, poses);
+    // The walking path, once the contacts are unified: no later pass changes a contact's yaw.
+    let path = path_of(poses).expect("a non-empty sequence has a path");
+    limit_swing_foot_rotation(poses, environment, &path, params.alpha());
+    after(Pass::LimitSwingFootRotation, poses);
+    scale_translation(poses, &path, params.scf);
+    after(Pass::ScaleTranslation, poses);
+    limit_to_max_step_size(poses, &path, params.s_max);
+    after(Pass::LimitToMaxStepSize, poses);
+    limit_orthogonal_feet_distance(poses, &path, params.o_min, params.o_max);
+    after(Pass::LimitOrthogonalFeetDistance, poses);
+    limit_swing_foot_height(poses, environment, params.h_min, params.h_max);
+    after(Pass::LimitSwingFootHeight, poses);
+}
+
+/// Hand-made pose sequences for the passes' unit tests.
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use kinematics::robot::EndEffector;
+    use nalgebra::{Isometry3, UnitQuaternion, Vector3};
+
+    use crate::poses::PoseSequence;
+
+    pub const BOTH: [bool; 4] = [true, true, false, false];
+    pub const LEFT: [bool; 4] = [true, false, false, false];
+    pub const RIGHT: [bool; 4] = [false, true, false, false];
+
+    /// One stance: left and right foot positions (identity rotation) and contact flags.
+    pub fn stance(
+        left: [f64; 3],
+        right: [f64; 3],
+        contacts: [bool; 4],
+    ) -> ([f64; 3], [f64; 3], [bool; 4]) {
+        (left, right, contacts)
+    }
+
+    /// A pose sequence from stances; the root sits 0.8 m above the feet's midpoint and the hands
+    /// 0.3 m to either side of the root.
+    pub fn walk(stances: &[([f64; 3], [f64; 3], [bool; 4])]) -> PoseSequence {
+        let mut poses = PoseSequence::default();
+        for &(left, right, contacts) in stances {
+            let (l, r) = (Vector3::from(left), Vector3::from(right));
+            let root = (l + r) / 2.0 + Vector3::new(0.0, 0.0, 0.8);
+            let at = |p: Vector3<f64>| Isometry3::translation(p.x, p.y, p.z);
+            poses.push(
+                at(root),
+                [
+                    at(l),
+                    at(r),
+                    at(root + Vector3::new(0.0, 0.3, 0.0)),
+                    at(root - Vector3::new(0.0, 0.3, 0.0)),
+                ],
+                contacts,
+            );
+        }
+        poses
+    }
+
+    /// Sets `e`'s rotation in stance `i` from roll/pitch/yaw.
+    pub fn rotated(poses: &mut PoseSequence, i: usize, e: EndEffector, rpy: [f64; 3]) {
+        poses.end_effectors[i][e as usize].rotation =
+            UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fixtures::{BOTH, rotated, stance, walk};
+    use super::*;
+    use crate::geometry::roll_pitch_yaw;
+    use crate::params::ContactUnification;
+    use kinematics::robot::EndEffector::{LeftFoot, RightFoot};
+
+    fn params() -> PostProcessParams {
+        PostProcessParams {
+            scf: 0.5,
+            s_max: 0.3,
+            o_min: 0.18,
+            o_max: 0.3,
+            alpha_x: 0.1,
+            alpha_y: 0.1,
+            alpha_z: 0.1,
+            h_min: 0.03,
+            h_max: 0.1,
+            contact_unification: ContactUnification::First,
+        }
+    }
+
+    #[test]
+    fn single_stance_sequence_is_made_executable() {
+        let mut p = walk(&[stance([0.0, 0.05, -0.2], [0.0, -0.05, -0.17], BOTH)]);
+        rotated(&mut p, 0, LeftFoot, [0.2, 0.1, 0.3]);
+        run_passes(&mut p, &Environment::default(), &params());
+        for foot in [LeftFoot, RightFoot] {
+            let pose = p.pose(0, foot);
+            let [roll, pitch, _] = roll_pitch_yaw(&pose.rotation);
+            assert!(pose.translation.z.abs() < 1e-12 && roll.abs() < 1e-12 && pitch.abs() < 1e-12);
+        }
+        // No root motion: the walking direction is the feet's mean heading (yaw 0.15).
+        let path = path_of(&p).unwrap();
+        assert!((path.heading() - 0.15).abs() < 1e-12);
+        let o = crate::derived::orthogonal_distances(&p, &path)[0];
+        assert!((o - 0.18).abs() < 1e-12, "{o}");
+    }
+
+    #[test]
+    fn passes_run_in_the_papers_order() {
+        let lines: Vec<usize> = Pass::ALL.iter().map(|p| p.line()).collect();
+        assert_eq!(lines, (2..=10).collect::<Vec<_>>());
+        let mut seen = Vec::new();
+        let mut p = walk(&[stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH)]);
+        run_passes_observed(&mut p, &Environment::default(), &params(), |pass, _| {
+            seen.push(pass)
+        });
+        assert_eq!(seen, Pass::ALL);
+    }
+}

@@ -1,0 +1,291 @@
+//! Passes 6–8: step geometry along and across the walking path.
+
+use kinematics::robot::EndEffector;
+use nalgebra::Vector3;
+
+use crate::geometry::PathFrame;
+use crate::poses::{FEET, PoseSequence};
+
+/// Pass 6, `scaleTranslation(scf)`: multiplies every along-path coordinate (roots and all
+/// end-effectors) by `scf`, keeping lateral offsets and heights. The map depends on the pose
+/// alone, so contacts that were static stay static, and the covered distance becomes `scf` times
+/// the original.
+pub fn scale_translation(poses: &mut PoseSequence, path: &PathFrame, scf: f64) {
+    if scf == 1.0 {
+        return;
+    }
+    let shrink = |p: &mut Vector3<f64>| *p -= path.direction() * ((1.0 - scf) * path.along(p));
+    for i in 0..poses.len() {
+        shrink(&mut poses.roots[i].translation.vector);
+        for pose in &mut poses.end_effectors[i] {
+            shrink(&mut pose.translation.vector);
+        }
+    }
+}
+
+/// The part of `step` beyond `±limit` (zero inside).
+fn excess(step: f64, limit: f64) -> f64 {
+    step - step.clamp(-limit, limit)
+}
+
+/// First stance at or after `from` where `e` is in contact.
+fn next_contact(poses: &PoseSequence, e: EndEffector, from: usize) -> Option<usize> {
+    (from..poses.len()).find(|&i| poses.in_contact(i, e))
+}
+
+/// Pass 7, `limitToMaxStepSize(s_max)`: shortens every step still longer than `s_max` (the
+/// along-path distance between consecutive contacts of one foot; backward steps alike) to
+/// exactly `s_max`. Everything after a shortened step moves back with it: the landing and all
+/// later contact runs, the roots and free end-effectors of later stances. A contact run moves as
+/// a whole (by the shift at its first stance), so no contact jumps; a swing foot's shift is
+/// interpolated between its lift-off and landing shifts. The covered distance shrinks.
+pub fn limit_to_max_step_size(poses: &mut PoseSequence, path: &PathFrame, s_max: f64) {
+    let mut state = StepLimit {
+        path,
+        s_max,
+        shift: 0.0,
+        run_shift: [0.0; 4],
+        last_run_end: [None; 4],
+        last_contact_along: [None; 2],
+    };
+    for i in 0..poses.len() {
+        for (f, &foot) in FEET.iter().enumerate() {
+            if poses.contact_starts(i, foot) {
+                let along = path.along(&poses.pose(i, foot).translation.vector) + state.shift;
+                state.shift -= state.landing_correction(f, along);
+            }
+        }
+        for e in EndEffector::ALL {
+            let de = if poses.in_contact(i, e) {
+                if poses.contact_starts(i, e) {
+                    state.run_shift[e as usize] = state.shift;
+                }
+                state.last_run_end[e as usize] = Some(i);
+                state.run_shift[e as usize]
+            } else {
+                state.swing_shift(poses, e, i)
+            };
+            if de != 0.0 {
+                poses.translate(i, e, &(path.direction() * de));
+            }
+        }
+        for (f, &foot) in FEET.iter().enumerate() {
+            if poses.contact_starts(i, foot) {
+                state.last_contact_along[f] =
+                    Some(path.along(&poses.pose(i, foot).translation.vector));
+            }
+        }
+        poses.roots[i].translation.vector += path.direction() * state.shift;
+    }
+}
+
+/// Running state of pass 7 (along-path shifts), so the pass needs no allocation.
+struct StepLimit<'p> {
+    path: &'p PathFrame,
+    s_max: f64,
+    /// Shift of the current stance.
+    shift: f64,
+    /// Shift of each end-effector's current (or last) contact run.
+    run_shift: [f64; 4],
+    /// Last stance each end-effector was in contact.
+    last_run_end: [Option<usize>; 4],
+    /// Shifted along-path position of each foot's last contact.
+    last_contact_along: [Option<f64>; 2],
+}
+
+impl StepLimit<'_> {
+    /// How much foot `f` landing at (shifted) `along` must move back for its step to fit.
+    fn landing_correction(&self, f: usize, along: f64) -> f64 {
+        self.last_contact_along[f].map_or(0.0, |previous| excess(along - previous, self.s_max))
+    }
+
+    /// Shift of a free end-effector in stance `i`: for a foot between two contacts, interpolated
+    /// (by stance index) from its lift-off shift to the shift its landing will get — only the
+    /// swinging foot can land before then, as the other one must stay in support; otherwise the
+    /// stance's shift.
+    fn swing_shift(&self, poses: &PoseSequence, e: EndEffector, i: usize) -> f64 {
+        let Some(f) = FEET.iter().position(|&f| f == e) else {
+            return self.shift;
+        };
+        let Some(lift) = self.last_run_end[e as usize] else {
+            return self.shift;
+        };
+        let Some(land) = next_contact(poses, e, i) else {
+            return self.shift;
+        };
+        let along = self.path.along(&poses.pose(land, e).translation.vector) + self.shift;
+        let landing_shift = self.shift - self.landing_correction(f, along);
+        let lifted = self.run_shift[e as usize];
+        lifted + (landing_shift - lifted) * (i - lift) as f64 / (land - lift) as f64
+    }
+}
+
+/// Pass 8, `limitOrthogonalFeetDistance(o_min, o_max)`: keeps the lateral distance between the
+/// feet, `o = (p_left − p_right) · lateral`, within `[o_min, o_max]` in every stance — which also
+/// removes the human gait's interlocking (feet crossing the midline). A foot that lands while
+/// the other stands is moved sideways (its whole contact run) to satisfy the limits against the
+/// standing foot; feet that land together are moved symmetrically; a swing foot is moved
+/// against the foot in support. Feet already inside the limits are not touched.
+pub fn limit_orthogonal_feet_distance(
+    poses: &mut PoseSequence,
+    path: &PathFrame,
+    o_min: f64,
+    o_max: f64,
+) {
+    let [left, right] = FEET;
+    let mut run_offset = [0.0; 2];
+    let lateral = |poses: &PoseSequence, i: usize, e: EndEffector| {
+        path.lateral(&poses.pose(i, e).translation.vector)
+    };
+    for i in 0..poses.len() {
+        let starts = [
+            poses.contact_starts(i, left),
+            poses.contact_starts(i, right),
+        ];
+        for (f, &start) in starts.iter().enumerate() {
+            if start {
+                run_offset[f] = 0.0;
+            }
+        }
+        if poses.in_contact(i, left) && poses.in_contact(i, right) {
+            let distance = (lateral(poses, i, left) + run_offset[0])
+                - (lateral(poses, i, right) + run_offset[1]);
+            let correction = distance.clamp(o_min, o_max) - distance;
+            match starts {
+                [true, true] => run_offset = [correction / 2.0, -correction / 2.0],
+                [true, false] => run_offset[0] += correction,
+                [false, true] => run_offset[1] -= correction,
+                [false, false] => {}
+            }
+        }
+        for (f, &foot) in FEET.iter().enumerate() {
+            if poses.in_contact(i, foot) && run_offset[f] != 0.0 {
+                poses.translate(i, foot, &(path.lateral_axis() * run_offset[f]));
+            }
+        }
+        let swing = match (poses.in_contact(i, left), poses.in_contact(i, right)) {
+            (true, false) => Some((right, -1.0)),
+            (false, true) => Some((left, 1.0)),
+            _ => None,
+        };
+        if let Some((foot, side)) = swing {
+            let distance = lateral(poses, i, left) - lateral(poses, i, right);
+            let correction = distance.clamp(o_min, o_max) - distance;
+            if correction != 0.0 {
+                poses.translate(i, foot, &(path.lateral_axis() * (side * correction)));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::derived::{orthogonal_distances, steps};
+    use crate::passes::fixtures::{BOTH, LEFT, RIGHT, stance, walk};
+    use kinematics::robot::EndEffector::{LeftFoot, RightFoot};
+
+    fn x_path() -> PathFrame {
+        PathFrame::new(&Vector3::zeros(), &Vector3::x()).unwrap()
+    }
+
+    /// DS, SS(right swings), DS, SS(left swings), DS with the given landing x positions.
+    fn gait(right_land: f64, left_land: f64) -> PoseSequence {
+        walk(&[
+            stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH),
+            stance([0.0, 0.1, 0.0], [right_land / 2.0, -0.1, 0.1], LEFT),
+            stance([0.0, 0.1, 0.0], [right_land, -0.1, 0.0], BOTH),
+            stance([left_land / 2.0, 0.1, 0.1], [right_land, -0.1, 0.0], RIGHT),
+            stance([left_land, 0.1, 0.0], [right_land, -0.1, 0.0], BOTH),
+        ])
+    }
+
+    #[test]
+    fn scaling_keeps_lateral_and_height() {
+        let mut p = gait(0.6, 1.2);
+        scale_translation(&mut p, &x_path(), 0.5);
+        let foot = p.pose(4, LeftFoot).translation.vector;
+        assert!((foot - Vector3::new(0.6, 0.1, 0.0)).norm() < 1e-12);
+        let swing = p.pose(1, RightFoot).translation.vector;
+        assert!((swing - Vector3::new(0.15, -0.1, 0.1)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn long_step_is_shortened_and_later_stances_follow() {
+        let mut p = gait(0.6, 1.2);
+        limit_to_max_step_size(&mut p, &x_path(), 0.4);
+        let s = steps(&p, &x_path());
+        assert_eq!(s.len(), 2);
+        assert!(
+            s.iter().all(|step| (step.length - 0.4).abs() < 1e-12),
+            "{s:?}"
+        );
+        assert!((p.pose(4, LeftFoot).translation.x - 0.4).abs() < 1e-12);
+        // The swing foot lies between its lift-off and landing.
+        assert!((p.pose(1, RightFoot).translation.x - 0.2).abs() < 1e-12);
+        assert_eq!(
+            p.pose(3, RightFoot),
+            p.pose(2, RightFoot),
+            "contact run static"
+        );
+    }
+
+    #[test]
+    fn step_exactly_at_s_max_is_untouched() {
+        let mut p = gait(0.4, 0.4);
+        let before = p.clone();
+        limit_to_max_step_size(&mut p, &x_path(), 0.4);
+        assert_eq!(p, before);
+    }
+
+    #[test]
+    fn interlocking_landing_is_moved_sideways_against_the_standing_foot() {
+        let mut p = walk(&[
+            stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH),
+            stance([0.0, 0.1, 0.0], [0.2, 0.05, 0.1], LEFT),
+            stance([0.0, 0.1, 0.0], [0.4, 0.12, 0.0], BOTH),
+            stance([0.0, 0.1, 0.0], [0.4, 0.12, 0.0], BOTH),
+        ]);
+        limit_orthogonal_feet_distance(&mut p, &x_path(), 0.18, 0.3);
+        assert_eq!(
+            p.pose(0, LeftFoot).translation.y,
+            0.1,
+            "standing foot stays"
+        );
+        assert!((p.pose(2, RightFoot).translation.y + 0.08).abs() < 1e-12);
+        assert_eq!(p.pose(3, RightFoot), p.pose(2, RightFoot));
+        assert!(
+            (p.pose(1, RightFoot).translation.y + 0.08).abs() < 1e-12,
+            "swing foot too"
+        );
+        for o in orthogonal_distances(&p, &x_path()) {
+            assert!((0.18 - 1e-12..=0.3 + 1e-12).contains(&o), "{o}");
+        }
+    }
+
+    #[test]
+    fn feet_landing_together_move_symmetrically() {
+        let mut p = walk(&[stance([0.0, 0.3, 0.0], [0.0, -0.3, 0.0], BOTH)]);
+        limit_orthogonal_feet_distance(&mut p, &x_path(), 0.18, 0.4);
+        assert!((p.pose(0, LeftFoot).translation.y - 0.2).abs() < 1e-12);
+        assert!((p.pose(0, RightFoot).translation.y + 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn feet_inside_the_limits_are_untouched() {
+        let mut p = gait(0.3, 0.6);
+        let before = p.clone();
+        limit_orthogonal_feet_distance(&mut p, &x_path(), 0.18, 0.3);
+        assert_eq!(p, before);
+    }
+
+    #[test]
+    fn right_swing_after_left_step() {
+        let mut p = walk(&[
+            stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH),
+            stance([0.3, 0.0, 0.1], [0.0, -0.1, 0.0], RIGHT),
+        ]);
+        limit_orthogonal_feet_distance(&mut p, &x_path(), 0.15, 0.3);
+        assert!((p.pose(1, LeftFoot).translation.y - 0.05).abs() < 1e-12);
+    }
+}

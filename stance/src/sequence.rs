@@ -1,0 +1,377 @@
+//! The stance data model (the paper's eq. 1) and the two sequences built from it: the raw
+//! sequence a stance source produces and the post-processed sequence the controller executes.
+//! Both are validated on construction, so a value of either type is always well-formed.
+
+use kinematics::robot::{EndEffector, Robot};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+
+use crate::environment::Environment;
+use crate::error::{FormatError, Location};
+
+/// One stance `S = { q_S, c_S(lf), c_S(rf), c_S(lh), c_S(rh), t_S }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stance {
+    /// Joint angles `q_S` of the whole robot, in the model's joint order.
+    pub q: Vec<f64>,
+    /// Contact flags indexed by [`EndEffector`] (`contacts[EndEffector::LeftFoot as usize]`).
+    pub contacts: [bool; 4],
+    /// Translation `t_S` of the root from the previous stance (from the world origin for the
+    /// first stance).
+    pub translation: Vector3<f64>,
+    /// Orientation of the root in the world. Eq. 1 has none (the identity is its default in the
+    /// file); a retargeted stance needs it to reproduce the end-effector poses it was solved for.
+    pub root_orientation: UnitQuaternion<f64>,
+}
+
+impl Stance {
+    /// Whether `end_effector` is in contact in this stance.
+    pub fn in_contact(&self, end_effector: EndEffector) -> bool {
+        self.contacts[end_effector as usize]
+    }
+}
+
+/// A sequence as a stance source delivers it, impediments included.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RawSequence {
+    pub(crate) robot: String,
+    pub(crate) joint_names: Vec<String>,
+    pub(crate) environment: Environment,
+    pub(crate) stances: Vec<Stance>,
+}
+
+/// A sequence after Algorithm 1: the raw stances (`q_S` and contact flags unchanged, root
+/// translations following the passes' moves) plus explicit world-frame target poses for every
+/// end-effector in every stance. This is what the controller executes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PostProcessedSequence {
+    pub(crate) robot: String,
+    pub(crate) joint_names: Vec<String>,
+    pub(crate) environment: Environment,
+    pub(crate) stances: Vec<Stance>,
+    pub(crate) targets: Vec<[Isometry3<f64>; 4]>,
+}
+
+/// Accumulates the stance translations into global root poses `GP_S`.
+fn accumulate_roots(stances: &[Stance]) -> impl Iterator<Item = Isometry3<f64>> + '_ {
+    stances.iter().scan(Vector3::zeros(), |position, stance| {
+        *position += stance.translation;
+        Some(Isometry3::from_parts(
+            Translation3::from(*position),
+            stance.root_orientation,
+        ))
+    })
+}
+
+impl RawSequence {
+    /// A validated raw sequence (see [`FormatError`] for what is refused).
+    pub fn new(
+        robot: String,
+        joint_names: Vec<String>,
+        environment: Environment,
+        stances: Vec<Stance>,
+    ) -> Result<Self, FormatError> {
+        validate(&robot, &joint_names, &environment, &stances)?;
+        Ok(Self {
+            robot,
+            joint_names,
+            environment,
+            stances,
+        })
+    }
+
+    /// Name of the robot the sequence is for.
+    pub fn robot(&self) -> &str {
+        &self.robot
+    }
+
+    /// Joint names, the order of every `q_S`.
+    pub fn joint_names(&self) -> &[String] {
+        &self.joint_names
+    }
+
+    /// Support surfaces and hand affordances.
+    pub fn environment(&self) -> &Environment {
+        &self.environment
+    }
+
+    /// The stances, never empty.
+    pub fn stances(&self) -> &[Stance] {
+        &self.stances
+    }
+
+    /// Number of stances (≥ 1).
+    pub fn len(&self) -> usize {
+        self.stances.len()
+    }
+
+    /// Always false: an empty sequence is refused on construction.
+    pub fn is_empty(&self) -> bool {
+        self.stances.is_empty()
+    }
+
+    /// Global root pose `GP_S` of every stance (accumulated translations, root orientation).
+    pub fn root_poses(&self) -> impl Iterator<Item = Isometry3<f64>> + '_ {
+        accumulate_roots(&self.stances)
+    }
+
+    /// Refuses the sequence if it is not for `robot` (name, joint names and order).
+    pub fn check_robot(&self, robot: &Robot) -> Result<(), FormatError> {
+        check_robot(&self.robot, &self.joint_names, robot)
+    }
+}
+
+impl PostProcessedSequence {
+    /// A validated post-processed sequence; `targets` holds one pose per end-effector per stance.
+    pub fn new(
+        robot: String,
+        joint_names: Vec<String>,
+        environment: Environment,
+        stances: Vec<Stance>,
+        targets: Vec<[Isometry3<f64>; 4]>,
+    ) -> Result<Self, FormatError> {
+        validate(&robot, &joint_names, &environment, &stances)?;
+        validate_targets(&targets, stances.len())?;
+        Ok(Self {
+            robot,
+            joint_names,
+            environment,
+            stances,
+            targets,
+        })
+    }
+
+    /// An empty value to be filled by [`crate::PostProcessor::process_into`] (reused buffers).
+    pub fn empty() -> Self {
+        Self {
+            robot: String::new(),
+            joint_names: Vec::new(),
+            environment: Environment::default(),
+            stances: Vec::new(),
+            targets: Vec::new(),
+        }
+    }
+
+    /// Name of the robot the sequence is for.
+    pub fn robot(&self) -> &str {
+        &self.robot
+    }
+
+    /// Joint names, the order of every posture.
+    pub fn joint_names(&self) -> &[String] {
+        &self.joint_names
+    }
+
+    /// Support surfaces and hand affordances.
+    pub fn environment(&self) -> &Environment {
+        &self.environment
+    }
+
+    /// The stances (`q_S`, contact flags, root translations).
+    pub fn stances(&self) -> &[Stance] {
+        &self.stances
+    }
+
+    /// Number of stances.
+    pub fn len(&self) -> usize {
+        self.stances.len()
+    }
+
+    /// True only for [`PostProcessedSequence::empty`]; a validated sequence has stances.
+    pub fn is_empty(&self) -> bool {
+        self.stances.is_empty()
+    }
+
+    /// Contact flags of stance `i`, indexed by [`EndEffector`]. Panics if `i >= len()`.
+    pub fn contacts(&self, i: usize) -> [bool; 4] {
+        self.stances[i].contacts
+    }
+
+    /// World-frame target pose of `end_effector` in stance `i` (a contact pose where the flag is
+    /// set, the swing/free pose otherwise). Panics if `i >= len()`.
+    pub fn target(&self, i: usize, end_effector: EndEffector) -> Isometry3<f64> {
+        self.targets[i][end_effector as usize]
+    }
+
+    /// All four targets of stance `i`, indexed by [`EndEffector`].
+    pub fn targets(&self, i: usize) -> &[Isometry3<f64>; 4] {
+        &self.targets[i]
+    }
+
+    /// The posture reference `q_S` of stance `i` (model joint order). Panics if `i >= len()`.
+    pub fn posture(&self, i: usize) -> &[f64] {
+        &self.stances[i].q
+    }
+
+    /// Global root pose of every stance after post-processing.
+    pub fn root_poses(&self) -> impl Iterator<Item = Isometry3<f64>> + '_ {
+        accumulate_roots(&self.stances)
+    }
+
+    /// Refuses the sequence if it is not for `robot` (name, joint names and order).
+    pub fn check_robot(&self, robot: &Robot) -> Result<(), FormatError> {
+        check_robot(&self.robot, &self.joint_names, robot)
+    }
+}
+
+/// Unit-norm tolerance for quaternions read from files.
+const QUATERNION_TOLERANCE: f64 = 1e-6;
+
+fn check_robot(name: &str, joint_names: &[String], robot: &Robot) -> Result<(), FormatError> {
+    if name != robot.name {
+        return Err(FormatError::UnknownRobot {
+            found: name.to_owned(),
+            expected: robot.name.clone(),
+        });
+    }
+    let expected = robot.model.joint_names();
+    if expected.len() != joint_names.len() {
+        return Err(FormatError::JointNameCount {
+            robot: robot.name.clone(),
+            expected: expected.len(),
+            found: joint_names.len(),
+        });
+    }
+    match expected.iter().zip(joint_names).position(|(a, b)| a != b) {
+        Some(index) => Err(FormatError::JointName {
+            index,
+            expected: expected[index].clone(),
+            found: joint_names[index].clone(),
+        }),
+        None => Ok(()),
+    }
+}
+
+fn finite(values: &[f64], location: impl FnOnce() -> Location) -> Result<(), FormatError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(FormatError::NonFinite {
+            location: location(),
+        })
+    }
+}
+
+pub(crate) fn check_rotation(
+    rotation: &UnitQuaternion<f64>,
+    location: impl Fn() -> Location,
+) -> Result<(), FormatError> {
+    finite(rotation.coords.as_slice(), &location)?;
+    let norm = rotation.coords.norm();
+    if (norm - 1.0).abs() > QUATERNION_TOLERANCE {
+        return Err(FormatError::NonUnitQuaternion {
+            location: location(),
+            norm,
+        });
+    }
+    Ok(())
+}
+
+pub(crate) fn check_pose(
+    pose: &Isometry3<f64>,
+    location: impl Fn() -> Location,
+) -> Result<(), FormatError> {
+    finite(pose.translation.vector.as_slice(), &location)?;
+    check_rotation(&pose.rotation, location)
+}
+
+fn validate(
+    robot: &str,
+    joint_names: &[String],
+    environment: &Environment,
+    stances: &[Stance],
+) -> Result<(), FormatError> {
+    if robot.is_empty() {
+        return Err(FormatError::Invalid {
+            location: Location::file("robot"),
+            message: "empty robot name".into(),
+        });
+    }
+    for (index, name) in joint_names.iter().enumerate() {
+        if name.is_empty() || joint_names[..index].contains(name) {
+            return Err(FormatError::BadJointName {
+                index,
+                name: name.clone(),
+            });
+        }
+    }
+    validate_environment(environment)?;
+    if stances.is_empty() {
+        return Err(FormatError::EmptySequence);
+    }
+    for (i, stance) in stances.iter().enumerate() {
+        if stance.q.len() != joint_names.len() {
+            return Err(FormatError::JointCount {
+                stance: i,
+                expected: joint_names.len(),
+                found: stance.q.len(),
+            });
+        }
+        if let Some(j) = stance.q.iter().position(|v| !v.is_finite()) {
+            return Err(FormatError::NonFinite {
+                location: Location::stance(i, format!("q[{j}]")),
+            });
+        }
+        finite(stance.translation.as_slice(), || {
+            Location::stance(i, "translation")
+        })?;
+        check_rotation(&stance.root_orientation, || {
+            Location::stance(i, "root_orientation")
+        })?;
+        if !stance.in_contact(EndEffector::LeftFoot) && !stance.in_contact(EndEffector::RightFoot) {
+            return Err(FormatError::NoFootSupport { stance: i });
+        }
+    }
+    Ok(())
+}
+
+fn validate_targets(targets: &[[Isometry3<f64>; 4]], stances: usize) -> Result<(), FormatError> {
+    if targets.len() != stances {
+        return Err(FormatError::Invalid {
+            location: Location::file("stances"),
+            message: format!("{} target sets for {stances} stances", targets.len()),
+        });
+    }
+    for (i, poses) in targets.iter().enumerate() {
+        for e in EndEffector::ALL {
+            check_pose(&poses[e as usize], || {
+                Location::stance(i, format!("targets.{}", e.name()))
+            })?;
+        }
+    }
+    Ok(())
+}
+
+fn validate_environment(environment: &Environment) -> Result<(), FormatError> {
+    if environment.surfaces.is_empty() {
+        return Err(FormatError::Invalid {
+            location: Location::file("environment.surfaces"),
+            message: "no support surface (the default is the ground plane z = 0)".into(),
+        });
+    }
+    for (k, surface) in environment.surfaces.iter().enumerate() {
+        let field = |f: &str| Location::file(format!("environment.surfaces[{k}].{f}"));
+        check_pose(&surface.pose, || field("pose"))?;
+        if let Some(polygon) = &surface.polygon {
+            if polygon.len() < 3 {
+                return Err(FormatError::Invalid {
+                    location: field("polygon"),
+                    message: format!("{} vertices, a polygon needs at least 3", polygon.len()),
+                });
+            }
+            finite(polygon.as_flattened(), || field("polygon"))?;
+        }
+    }
+    for (k, affordance) in environment.hand_affordances.iter().enumerate() {
+        let field = |f: &str| Location::file(format!("environment.hand_affordances[{k}].{f}"));
+        finite(affordance.start.as_slice(), || field("start"))?;
+        finite(affordance.end.as_slice(), || field("end"))?;
+        finite(&affordance.available, || field("available"))?;
+        if affordance.available[0] > affordance.available[1] {
+            return Err(FormatError::Invalid {
+                location: field("available"),
+                message: "interval start after its end".into(),
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,247 @@
+//! The stance file: round trips, and one refused file per error class, each with a message that
+//! names the stance index and field (or line and column).
+
+mod common;
+
+use serde_json::{Value, json};
+use stance::{
+    AffordanceSet, FormatError, GenerateOptions, Location, PostProcessedSequence, PostProcessor,
+    RawSequence, generate,
+};
+
+fn raw() -> RawSequence {
+    let (robot, _) = common::jvrc1();
+    generate(
+        robot,
+        &GenerateOptions {
+            distance: 1.0,
+            affordances: AffordanceSet::FeetRightHand,
+            seed: 4,
+        },
+    )
+    .unwrap()
+}
+
+fn processed() -> PostProcessedSequence {
+    let (robot, params) = common::jvrc1();
+    PostProcessor::new(robot, params.clone())
+        .process(&raw())
+        .unwrap()
+}
+
+/// The raw file as JSON, edited by `edit`, read back for JVRC-1.
+fn read_edited(edit: impl FnOnce(&mut Value)) -> Result<RawSequence, FormatError> {
+    let mut value: Value = serde_json::from_str(&raw().to_json_string()).unwrap();
+    edit(&mut value);
+    RawSequence::from_json_str(&value.to_string(), &common::jvrc1().0)
+}
+
+#[test]
+fn raw_and_post_processed_files_round_trip() {
+    let (robot, _) = common::jvrc1();
+    let raw = raw();
+    assert_eq!(
+        RawSequence::from_json_str(&raw.to_json_string(), robot).unwrap(),
+        raw
+    );
+    let pp = processed();
+    let back = PostProcessedSequence::from_json_str(&pp.to_json_string(), robot).unwrap();
+    assert_eq!(back.len(), pp.len());
+    for i in 0..pp.len() {
+        assert_eq!(back.posture(i), pp.posture(i));
+        assert_eq!(back.contacts(i), pp.contacts(i));
+        for (a, b) in back.targets(i).iter().zip(pp.targets(i)) {
+            assert!((a.translation.vector - b.translation.vector).norm() < 1e-12);
+            assert!(a.rotation.angle_to(&b.rotation) < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn truncated_json_is_refused_with_its_position() {
+    let text = raw().to_json_string();
+    let cut = &text[..text.len() * 2 / 3];
+    let err = RawSequence::from_json_str(cut, &common::jvrc1().0).unwrap_err();
+    let FormatError::Truncated { line, location, .. } = &err else {
+        panic!("{err}")
+    };
+    assert!(*line > 1 && location.stance.is_some(), "{err}");
+    assert!(err.to_string().contains("truncated JSON"), "{err}");
+}
+
+#[test]
+fn nan_is_refused_naming_stance_and_field() {
+    let text = raw().to_json_string();
+    let mut value: Value = serde_json::from_str(&text).unwrap();
+    value["stances"][3]["q"][5] = json!(12345.678);
+    let text = value.to_string().replace("12345.678", "NaN");
+    let err = RawSequence::from_json_str(&text, &common::jvrc1().0).unwrap_err();
+    assert_eq!(
+        err,
+        FormatError::NonFinite {
+            location: Location::stance(3, "q[5]")
+        },
+        "{err}"
+    );
+    assert_eq!(
+        err.to_string(),
+        "stance 3, field `q[5]`: non-finite number (NaN or infinity) is not allowed"
+    );
+    // An overflowing number is an infinity: refused the same way.
+    let text = value.to_string().replace("12345.678", "1e999");
+    let err = RawSequence::from_json_str(&text, &common::jvrc1().0).unwrap_err();
+    assert_eq!(
+        err,
+        FormatError::NonFinite {
+            location: Location::stance(3, "q[5]")
+        },
+        "{err}"
+    );
+}
+
+#[test]
+fn wrong_joint_count_in_a_stance_is_refused() {
+    let err = read_edited(|v| {
+        v["stances"][2]["q"].as_array_mut().unwrap().pop();
+    })
+    .unwrap_err();
+    assert!(
+        matches!(
+            err,
+            FormatError::JointCount {
+                stance: 2,
+                expected: 34,
+                found: 33
+            }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().starts_with("stance 2, field `q`"), "{err}");
+}
+
+#[test]
+fn wrong_joint_names_are_refused() {
+    let err = read_edited(|v| v["joint_names"][4] = json!("R_KNEE_TYPO")).unwrap_err();
+    assert!(
+        matches!(&err, FormatError::JointName { index: 4, found, .. } if found == "R_KNEE_TYPO"),
+        "{err}"
+    );
+    let err = read_edited(|v| {
+        v["joint_names"].as_array_mut().unwrap().pop();
+        for stance in v["stances"].as_array_mut().unwrap() {
+            stance["q"].as_array_mut().unwrap().pop();
+        }
+    })
+    .unwrap_err();
+    assert!(
+        matches!(
+            err,
+            FormatError::JointNameCount {
+                expected: 34,
+                found: 33,
+                ..
+            }
+        ),
+        "{err}"
+    );
+}
+
+#[test]
+fn empty_sequence_is_refused() {
+    let err = read_edited(|v| v["stances"] = json!([])).unwrap_err();
+    assert_eq!(err, FormatError::EmptySequence);
+    assert!(err.to_string().contains("`stances`"));
+}
+
+#[test]
+fn unknown_robot_is_refused() {
+    let err = read_edited(|v| v["robot"] = json!("hrp5")).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "field `robot`: unknown robot `hrp5`; the loaded robot is `jvrc1`"
+    );
+}
+
+#[test]
+fn stance_without_foot_support_is_refused() {
+    let err = read_edited(|v| v["stances"][6]["contacts"] = json!(["right_hand"])).unwrap_err();
+    assert_eq!(err, FormatError::NoFootSupport { stance: 6 });
+    assert!(
+        err.to_string().starts_with("stance 6, field `contacts`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn structural_errors_name_their_field() {
+    let err = read_edited(|v| v["stances"][1]["translaton"] = json!([0, 0, 0])).unwrap_err();
+    assert!(
+        matches!(&err, FormatError::Structure { location, .. } if location.stance == Some(1)),
+        "{err}"
+    );
+    assert!(err.to_string().contains("translaton"), "{err}");
+    let err = read_edited(|v| v["format_version"] = json!(2)).unwrap_err();
+    assert!(
+        matches!(err, FormatError::UnsupportedVersion { found: 2, .. }),
+        "{err}"
+    );
+    let err = read_edited(|v| v["stances"][0]["contacts"] = json!(["left_foot", "left_foot"]))
+        .unwrap_err();
+    assert!(
+        matches!(err, FormatError::BadContact { stance: 0, .. }),
+        "{err}"
+    );
+    let err =
+        read_edited(|v| v["stances"][2]["root_orientation"] = json!([0, 0, 0, 2])).unwrap_err();
+    assert!(
+        matches!(err, FormatError::NonUnitQuaternion { .. }),
+        "{err}"
+    );
+    assert!(
+        err.to_string()
+            .starts_with("stance 2, field `root_orientation`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn files_of_the_other_kind_are_refused() {
+    let (robot, _) = common::jvrc1();
+    let err = RawSequence::from_json_str(&processed().to_json_string(), robot).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            FormatError::WrongKind {
+                expected: "raw",
+                ..
+            }
+        ),
+        "{err}"
+    );
+    let err = PostProcessedSequence::from_json_str(&raw().to_json_string(), robot).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            FormatError::WrongKind {
+                expected: "post_processed",
+                ..
+            }
+        ),
+        "{err}"
+    );
+}
+
+#[test]
+fn post_processed_target_nan_is_refused() {
+    let text = processed().to_json_string();
+    let mut value: Value = serde_json::from_str(&text).unwrap();
+    value["stances"][2]["targets"]["left_hand"]["translation"][1] = json!(12345.678);
+    let text = value.to_string().replace("12345.678", "-Infinity");
+    let err = PostProcessedSequence::from_json_str(&text, &common::jvrc1().0).unwrap_err();
+    assert_eq!(
+        err,
+        FormatError::NonFinite {
+            location: Location::stance(2, "targets.left_hand.translation[1]")
+        }
+    );
+}
