@@ -128,38 +128,69 @@ fn pubsub_error(service: &str, error: PublishSubscribeOpenOrCreateError) -> ShmE
 
 fn pubsub_open_error(service: &str, error: PublishSubscribeOpenError) -> ShmError {
     match error {
-        PublishSubscribeOpenError::IncompatibleTypes => ShmError::ProtocolMismatch {
-            service: service.to_owned(),
-            ours: PROTOCOL_VERSION,
-        },
-        PublishSubscribeOpenError::DoesNotExist => ShmError::NotRunning {
-            service: service.to_owned(),
-        },
+        PublishSubscribeOpenError::IncompatibleTypes => protocol_mismatch(service),
+        PublishSubscribeOpenError::DoesNotExist => not_running(service),
         other => ShmError::ipc("open", service, other),
     }
 }
 
-fn request_response_error(service: &str, error: RequestResponseOpenError) -> ShmError {
+fn request_response_error(service: &str, error: RequestResponseOpenOrCreateError) -> ShmError {
     match error {
-        RequestResponseOpenError::IncompatibleRequestOrResponseType => ShmError::ProtocolMismatch {
-            service: service.to_owned(),
-            ours: PROTOCOL_VERSION,
-        },
-        RequestResponseOpenError::DoesNotExist => ShmError::NotRunning {
-            service: service.to_owned(),
-        },
+        RequestResponseOpenOrCreateError::RequestResponseOpenError(e) => {
+            request_response_open_error(service, e)
+        }
+        other => ShmError::ipc("open or create", service, other),
+    }
+}
+
+fn request_response_open_error(service: &str, error: RequestResponseOpenError) -> ShmError {
+    match error {
+        RequestResponseOpenError::IncompatibleRequestOrResponseType => protocol_mismatch(service),
+        RequestResponseOpenError::DoesNotExist => not_running(service),
         other => ShmError::ipc("open", service, other),
     }
 }
 
-/// A high-rate stream (sensors, commands): newest wins, a late subscriber gets the last one.
-fn stream<T: core::fmt::Debug + ZeroCopySend + 'static>(
+/// The peer that created `service` uses other message types: another protocol version.
+fn protocol_mismatch(service: &str) -> ShmError {
+    ShmError::ProtocolMismatch {
+        service: service.to_owned(),
+        ours: PROTOCOL_VERSION,
+    }
+}
+
+/// Nobody created `service`: no daemon serves this prefix.
+fn not_running(service: &str) -> ShmError {
+    ShmError::NotRunning {
+        service: service.to_owned(),
+    }
+}
+
+/// A payload that travels on a high-rate stream of its own; the type names the stream, so a port
+/// cannot open a stream with the wrong payload.
+pub(crate) trait StreamPayload:
+    core::fmt::Debug + ZeroCopySend + Copy + Default + 'static
+{
+    /// The stream's kind: the last part of its service name.
+    const KIND: &'static str;
+}
+
+impl StreamPayload for SensorSample {
+    const KIND: &'static str = SENSORS;
+}
+
+impl StreamPayload for JointCommand {
+    const KIND: &'static str = COMMANDS;
+}
+
+/// The stream that carries `T` (sensors, commands): newest wins, a late subscriber gets the last
+/// one.
+pub(crate) fn stream<T: StreamPayload>(
     node: &IpcNode,
     names: &ServiceNames,
-    kind: &str,
 ) -> Result<PubSub<T>, ShmError> {
-    let service = names.full(kind);
-    node.service_builder(&names.service_name(kind)?)
+    let service = names.full(T::KIND);
+    node.service_builder(&names.service_name(T::KIND)?)
         .publish_subscribe::<T>()
         .enable_safe_overflow(true)
         .history_size(1)
@@ -171,37 +202,18 @@ fn stream<T: core::fmt::Debug + ZeroCopySend + 'static>(
         .map_err(|e| pubsub_error(&service, e))
 }
 
-/// The wake-up event that accompanies a stream.
-fn stream_event(node: &IpcNode, names: &ServiceNames, kind: &str) -> Result<Event, ShmError> {
-    let service = names.full(kind);
-    node.service_builder(&names.service_name(kind)?)
+/// The wake-up event that accompanies the stream of `T`.
+pub(crate) fn stream_event<T: StreamPayload>(
+    node: &IpcNode,
+    names: &ServiceNames,
+) -> Result<Event, ShmError> {
+    let service = names.full(T::KIND);
+    node.service_builder(&names.service_name(T::KIND)?)
         .event()
         .max_notifiers(4)
         .max_listeners(8)
         .open_or_create()
         .map_err(|e: EventOpenOrCreateError| ShmError::ipc("open or create event", &service, e))
-}
-
-pub(crate) fn sensors(
-    node: &IpcNode,
-    names: &ServiceNames,
-) -> Result<PubSub<SensorSample>, ShmError> {
-    stream(node, names, SENSORS)
-}
-
-pub(crate) fn sensors_event(node: &IpcNode, names: &ServiceNames) -> Result<Event, ShmError> {
-    stream_event(node, names, SENSORS)
-}
-
-pub(crate) fn commands(
-    node: &IpcNode,
-    names: &ServiceNames,
-) -> Result<PubSub<JointCommand>, ShmError> {
-    stream(node, names, COMMANDS)
-}
-
-pub(crate) fn commands_event(node: &IpcNode, names: &ServiceNames) -> Result<Event, ShmError> {
-    stream_event(node, names, COMMANDS)
 }
 
 pub(crate) fn status(
@@ -240,15 +252,12 @@ macro_rules! request_response_service {
             .max_active_requests_per_client(2)
             .max_response_buffer_size(2);
         match $access {
-            Access::OpenOrCreate => builder.open_or_create().map_err(|e| match e {
-                RequestResponseOpenOrCreateError::RequestResponseOpenError(e) => {
-                    request_response_error(&service, e)
-                }
-                other => ShmError::ipc("open or create", &service, other),
-            }),
+            Access::OpenOrCreate => builder
+                .open_or_create()
+                .map_err(|e| request_response_error(&service, e)),
             Access::OpenOnly => builder
                 .open()
-                .map_err(|e| request_response_error(&service, e)),
+                .map_err(|e| request_response_open_error(&service, e)),
         }
     }};
 }
@@ -272,4 +281,38 @@ pub(crate) fn control(
 /// Converts an absolute time on [`crate::monotonic_ns`] into the timeout left until then.
 pub fn time_until(deadline_ns: u64) -> Duration {
     Duration::from_nanos(deadline_ns.saturating_sub(crate::monotonic_ns()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::AdapterPorts;
+
+    /// A sample type from "another protocol version": same layout idea, other type name.
+    #[repr(C)]
+    #[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
+    #[type_name("walk.v0.SensorSample")]
+    struct OldSensorSample {
+        seq: u64,
+    }
+
+    /// The v0 peer used the same stream and the same QoS, so only the type differs.
+    impl StreamPayload for OldSensorSample {
+        const KIND: &'static str = SENSORS;
+    }
+
+    #[test]
+    fn a_peer_of_another_protocol_version_is_refused_at_connect() {
+        let prefix = format!("walk-test/shm-types/mismatch/{}", std::process::id());
+        let names = ServiceNames::new(&prefix).unwrap();
+        let (node, _) = create_node("v0-peer").unwrap();
+        let _old = stream::<OldSensorSample>(&node, &names).unwrap();
+        match AdapterPorts::open(&names, "adapter") {
+            Err(error @ ShmError::ProtocolMismatch { .. }) => {
+                assert!(error.to_string().contains(&format!("{prefix}/sensors")));
+            }
+            Err(other) => panic!("expected a protocol mismatch, got {other}"),
+            Ok(_) => panic!("a v0 service was opened with v1 types"),
+        }
+    }
 }

@@ -3,7 +3,6 @@
 use std::process::Command;
 use std::time::Duration;
 
-use iceoryx2::prelude::*;
 use shm_types::{
     AdapterPorts, ClientPorts, ControlCommand, ControlReply, DaemonLoopPorts, DaemonServicePorts,
     DaemonStatus, JointCommand, SensorSample, ServiceNames, ShmError, SubmitReply,
@@ -127,42 +126,6 @@ fn run_peer(prefix: &str) {
     assert!(reply.accepted);
     assert_eq!(reply.status.ticks, ROUNDS);
     assert_eq!(client.next_status(TIMEOUT).unwrap().ticks, ROUNDS);
-}
-
-/// A sample type from "another protocol version": same layout idea, other type name.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
-#[type_name("walk.v0.SensorSample")]
-struct OldSensorSample {
-    seq: u64,
-}
-
-#[test]
-fn a_peer_of_another_protocol_version_is_refused_at_connect() {
-    let prefix = unique_prefix("mismatch");
-    let node = NodeBuilder::new()
-        .signal_handling_mode(SignalHandlingMode::Disabled)
-        .create::<ipc::Service>()
-        .unwrap();
-    let _old = node
-        .service_builder(&format!("{prefix}/sensors").as_str().try_into().unwrap())
-        .publish_subscribe::<OldSensorSample>()
-        .enable_safe_overflow(true)
-        .history_size(1)
-        .subscriber_max_buffer_size(4)
-        .subscriber_max_borrowed_samples(4)
-        .max_publishers(2)
-        .max_subscribers(8)
-        .create()
-        .unwrap();
-    let names = ServiceNames::new(&prefix).unwrap();
-    match AdapterPorts::open(&names, "adapter") {
-        Err(error @ ShmError::ProtocolMismatch { .. }) => {
-            assert!(error.to_string().contains(&format!("{prefix}/sensors")));
-        }
-        Err(other) => panic!("expected a protocol mismatch, got {other}"),
-        Ok(_) => panic!("a v0 service was opened with v1 types"),
-    }
 }
 
 #[test]

@@ -7,6 +7,7 @@ use kinematics::robot::Robot;
 use shm_types::SensorSample;
 
 use crate::RobotIo;
+use crate::robot_io::fill_sample;
 
 /// The kinematic simulator as a robot: an ideal position servo whose floating base follows the
 /// feet in contact; force readings from static equilibrium; an ideal IMU.
@@ -37,14 +38,7 @@ impl RobotIo for KinematicRobot {
     }
 
     fn read(&mut self, sample: &mut SensorSample) {
-        let measurement = self.sim.measurement();
-        let n = measurement.q.len();
-        sample.q[..n].copy_from_slice(measurement.q.as_slice());
-        sample.qd[..n].copy_from_slice(measurement.qd.as_slice());
-        sample.wrenches = measurement.wrenches;
-        let q = measurement.base_orientation.quaternion();
-        sample.imu_orientation = [q.i, q.j, q.k, q.w];
-        sample.has_imu = true;
+        fill_sample(self.sim.measurement(), sample);
     }
 
     fn write(&mut self, q_des: &[f64], qd_des: &[f64], dt: f64) -> Result<(), SimError> {

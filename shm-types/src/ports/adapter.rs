@@ -22,19 +22,9 @@ impl AdapterPorts {
     /// before or after the daemon.
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, _) = services::create_node(node_name)?;
-        let sensors = StreamSender::new(
-            names.full("sensors"),
-            services::sensors(&node, names)?,
-            services::sensors_event(&node, names)?,
-        )?;
-        let commands = StreamReceiver::new(
-            names.full("commands"),
-            services::commands(&node, names)?,
-            services::commands_event(&node, names)?,
-        )?;
         Ok(Self {
-            sensors,
-            commands,
+            sensors: StreamSender::open(&node, names)?,
+            commands: StreamReceiver::open(&node, names)?,
             _node: node,
         })
     }

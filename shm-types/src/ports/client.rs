@@ -2,6 +2,7 @@
 
 use core::time::Duration;
 
+use iceoryx2::pending_response::PendingResponse;
 use iceoryx2::port::client::Client;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
@@ -108,12 +109,7 @@ impl ClientPorts {
             .write_from_slice(json)
             .send()
             .map_err(|e| ShmError::ipc("send to", &service, e))?;
-        poll_until(&service, timeout, || {
-            pending
-                .receive()
-                .map(|reply| reply.map(|r| *r.payload()))
-                .map_err(|e| ShmError::ipc("receive reply from", &service, e))
-        })
+        wait_for_reply(&service, timeout, &pending)
     }
 
     /// Sends a control command and waits up to `timeout` for the answer.
@@ -127,13 +123,26 @@ impl ClientPorts {
             .control
             .send_copy(ControlRequest { command })
             .map_err(|e| ShmError::ipc("send to", &service, e))?;
-        poll_until(&service, timeout, || {
-            pending
-                .receive()
-                .map(|reply| reply.map(|r| *r.payload()))
-                .map_err(|e| ShmError::ipc("receive reply from", &service, e))
-        })
+        wait_for_reply(&service, timeout, &pending)
     }
+}
+
+/// Waits up to `timeout` for the server's answer to a sent request.
+fn wait_for_reply<Request, Reply>(
+    service: &str,
+    timeout: Duration,
+    pending: &PendingResponse<ipc::Service, Request, (), Reply, ()>,
+) -> Result<Reply, ShmError>
+where
+    Request: core::fmt::Debug + IceoryxSend + ?Sized,
+    Reply: core::fmt::Debug + ZeroCopySend + Copy,
+{
+    poll_until(service, timeout, || {
+        pending
+            .receive()
+            .map(|reply| reply.map(|r| *r.payload()))
+            .map_err(|e| ShmError::ipc("receive reply from", service, e))
+    })
 }
 
 /// Calls `poll` every millisecond until it yields a value or `timeout` passes.

@@ -25,19 +25,9 @@ impl DaemonLoopPorts {
     /// Opens (or creates) `sensors` and `commands` under `names`.
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, _) = services::create_node(node_name)?;
-        let sensors = StreamReceiver::new(
-            names.full("sensors"),
-            services::sensors(&node, names)?,
-            services::sensors_event(&node, names)?,
-        )?;
-        let commands = StreamSender::new(
-            names.full("commands"),
-            services::commands(&node, names)?,
-            services::commands_event(&node, names)?,
-        )?;
         Ok(Self {
-            sensors,
-            commands,
+            sensors: StreamReceiver::open(&node, names)?,
+            commands: StreamSender::open(&node, names)?,
             _node: node,
         })
     }

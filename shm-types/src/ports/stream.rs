@@ -11,11 +11,11 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 
-use crate::ShmError;
-use crate::services::{Event, PubSub};
+use crate::services::{self, Event, IpcNode, PubSub, StreamPayload};
+use crate::{ServiceNames, ShmError};
 
 /// Sending end: publish + notify.
-pub(crate) struct StreamSender<T: core::fmt::Debug + ZeroCopySend + 'static> {
+pub(crate) struct StreamSender<T: StreamPayload> {
     service_name: String,
     publisher: Publisher<ipc::Service, T, ()>,
     notifier: Notifier<ipc::Service>,
@@ -23,12 +23,12 @@ pub(crate) struct StreamSender<T: core::fmt::Debug + ZeroCopySend + 'static> {
     _event: Event,
 }
 
-impl<T: core::fmt::Debug + ZeroCopySend + Default + 'static> StreamSender<T> {
-    pub(crate) fn new(
-        service_name: String,
-        service: PubSub<T>,
-        event: Event,
-    ) -> Result<Self, ShmError> {
+impl<T: StreamPayload> StreamSender<T> {
+    /// Opens (or creates) the stream of `T` under `names` and its event, as their sender.
+    pub(crate) fn open(node: &IpcNode, names: &ServiceNames) -> Result<Self, ShmError> {
+        let service_name = names.full(T::KIND);
+        let service = services::stream::<T>(node, names)?;
+        let event = services::stream_event::<T>(node, names)?;
         let publisher = service
             .publisher_builder()
             .max_loaned_samples(2)
@@ -66,7 +66,7 @@ impl<T: core::fmt::Debug + ZeroCopySend + Default + 'static> StreamSender<T> {
 }
 
 /// Receiving end: wait for the wake-up, take the newest message.
-pub(crate) struct StreamReceiver<T: core::fmt::Debug + ZeroCopySend + 'static> {
+pub(crate) struct StreamReceiver<T: StreamPayload> {
     service_name: String,
     subscriber: Subscriber<ipc::Service, T, ()>,
     listener: Listener<ipc::Service>,
@@ -74,12 +74,12 @@ pub(crate) struct StreamReceiver<T: core::fmt::Debug + ZeroCopySend + 'static> {
     _event: Event,
 }
 
-impl<T: core::fmt::Debug + ZeroCopySend + Copy + 'static> StreamReceiver<T> {
-    pub(crate) fn new(
-        service_name: String,
-        service: PubSub<T>,
-        event: Event,
-    ) -> Result<Self, ShmError> {
+impl<T: StreamPayload> StreamReceiver<T> {
+    /// Opens (or creates) the stream of `T` under `names` and its event, as their receiver.
+    pub(crate) fn open(node: &IpcNode, names: &ServiceNames) -> Result<Self, ShmError> {
+        let service_name = names.full(T::KIND);
+        let service = services::stream::<T>(node, names)?;
+        let event = services::stream_event::<T>(node, names)?;
         let subscriber = service
             .subscriber_builder()
             .create()

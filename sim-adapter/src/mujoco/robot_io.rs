@@ -9,6 +9,7 @@ use shm_types::SensorSample;
 
 use super::{MujocoError, MujocoOptions, MujocoSim};
 use crate::RobotIo;
+use crate::robot_io::fill_sample;
 
 /// The MuJoCo simulator as a robot: joint servos under rigid-body dynamics, foot FT from the
 /// contact forces, an IMU on the base.
@@ -49,14 +50,7 @@ impl RobotIo for MujocoRobot {
     }
 
     fn read(&mut self, sample: &mut SensorSample) {
-        let measurement = self.sim.measurement();
-        let n = measurement.q.len();
-        sample.q[..n].copy_from_slice(measurement.q.as_slice());
-        sample.qd[..n].copy_from_slice(measurement.qd.as_slice());
-        sample.wrenches = measurement.wrenches;
-        let q = measurement.base_orientation.quaternion();
-        sample.imu_orientation = [q.i, q.j, q.k, q.w];
-        sample.has_imu = true;
+        fill_sample(self.sim.measurement(), sample);
     }
 
     fn write(&mut self, q_des: &[f64], qd_des: &[f64], dt: f64) -> Result<(), MujocoError> {

@@ -484,24 +484,8 @@ fn check_options(options: &MujocoOptions) -> Result<(), MujocoError> {
         ("friction", o.friction),
         ("fall_height_fraction", o.fall_height_fraction),
     ];
-    for (name, value) in positive {
-        if !(value.is_finite() && value > 0.0) {
-            return Err(MujocoError::BadOption {
-                name,
-                value,
-                requirement: "positive and finite",
-            });
-        }
-    }
-    for (name, value) in non_negative {
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(MujocoError::BadOption {
-                name,
-                value,
-                requirement: "non-negative and finite",
-            });
-        }
-    }
+    require_all(&positive, |v| v > 0.0, "positive and finite")?;
+    require_all(&non_negative, |v| v >= 0.0, "non-negative and finite")?;
     if o.contact_time_constant < 2.0 * o.timestep {
         return Err(MujocoError::BadOption {
             name: "contact_time_constant",
@@ -510,4 +494,82 @@ fn check_options(options: &MujocoOptions) -> Result<(), MujocoError> {
         });
     }
     Ok(())
+}
+
+/// Fails on the first option that is not finite or not `allowed`, naming it and `requirement`.
+fn require_all(
+    options: &[(&'static str, f64)],
+    allowed: impl Fn(f64) -> bool,
+    requirement: &'static str,
+) -> Result<(), MujocoError> {
+    match options
+        .iter()
+        .find(|&&(_, value)| !(value.is_finite() && allowed(value)))
+    {
+        Some(&(name, value)) => Err(MujocoError::BadOption {
+            name,
+            value,
+            requirement,
+        }),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The option that failed and the requirement it broke, or `None` when all pass.
+    fn rejection(options: MujocoOptions) -> Option<(&'static str, &'static str)> {
+        match check_options(&options) {
+            Ok(()) => None,
+            Err(MujocoError::BadOption {
+                name, requirement, ..
+            }) => Some((name, requirement)),
+            Err(other) => panic!("unexpected error {other}"),
+        }
+    }
+
+    #[test]
+    fn bad_options_are_rejected_by_name() {
+        let defaults = MujocoOptions::default();
+        assert_eq!(rejection(defaults), None);
+        let zero_damping = MujocoOptions {
+            servo_damping: 0.0,
+            ..defaults
+        };
+        assert_eq!(rejection(zero_damping), None);
+        let zero_timestep = MujocoOptions {
+            timestep: 0.0,
+            ..defaults
+        };
+        assert_eq!(
+            rejection(zero_timestep),
+            Some(("timestep", "positive and finite"))
+        );
+        let nan_friction = MujocoOptions {
+            friction: f64::NAN,
+            ..defaults
+        };
+        assert_eq!(
+            rejection(nan_friction),
+            Some(("friction", "non-negative and finite"))
+        );
+        let negative_armature = MujocoOptions {
+            armature: -1.0,
+            ..defaults
+        };
+        assert_eq!(
+            rejection(negative_armature),
+            Some(("armature", "non-negative and finite"))
+        );
+        let stiff_contact = MujocoOptions {
+            contact_time_constant: defaults.timestep,
+            ..defaults
+        };
+        assert_eq!(
+            rejection(stiff_contact),
+            Some(("contact_time_constant", "at least twice the timestep"))
+        );
+    }
 }
