@@ -1,0 +1,298 @@
+//! `walkd bench`: generate, post-process and execute a walk in-process against the kinematic
+//! simulator, as fast as possible, and report outcome, safety and timing.
+//!
+//! Timing is taken here, outside the controller core: the tick duration around
+//! `Controller::tick`, and the QP time by re-solving each tick's QP (the controller's
+//! `last_problem`) with a second solver of the same kind, warm-started the same way.
+
+mod walk;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::Context;
+use hdrhistogram::Histogram;
+use kinematics::robot::Robot;
+use stance::{AffordanceSet, GenerateOptions, PostProcessParams, PostProcessor};
+
+use crate::controller::{ControllerConfig, ControllerState, SolverKind};
+use crate::qp::{ClarabelSolver, DenseActiveSetSolver, QpSolver, export_json};
+
+pub use walk::{Outcome, TickObservation, WalkError, WalkOptions, WalkReport, walk};
+
+/// Control rate when neither `--rate-hz` nor `[runtime] rate_hz` gives one (Hz).
+const DEFAULT_RATE_HZ: f64 = 500.0;
+/// Every this many executing ticks one QP goes into the `--export-qp` sample ...
+const EXPORT_EVERY: u64 = 50;
+/// ... up to this many problems.
+const EXPORT_MAX: usize = 200;
+
+/// QP back-end names on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SolverArg {
+    /// Dense active set (default).
+    Dense,
+    /// Clarabel interior point.
+    Clarabel,
+}
+
+impl From<SolverArg> for SolverKind {
+    fn from(arg: SolverArg) -> Self {
+        match arg {
+            SolverArg::Dense => SolverKind::Dense,
+            SolverArg::Clarabel => SolverKind::Clarabel,
+        }
+    }
+}
+
+/// Arguments of `walkd bench`.
+#[derive(Debug, clap::Args)]
+pub struct BenchArgs {
+    /// Robot config (TOML with [robot], [postprocess], [controller], [runtime]).
+    #[arg(long, value_name = "CONFIG")]
+    pub robot: PathBuf,
+    /// URDF overriding the config's (required for HRP-4).
+    #[arg(long, value_name = "PATH")]
+    pub urdf: Option<PathBuf>,
+    /// Distance to walk (m), requested from the generator as distance / scf.
+    #[arg(long, value_name = "D")]
+    pub distance: f64,
+    /// Support affordances: feet, feet+left-hand or feet+right-hand.
+    #[arg(long, value_name = "SET", default_value = "feet")]
+    pub affordances: AffordanceSet,
+    /// QP back-end.
+    #[arg(long, value_enum, default_value = "dense")]
+    pub solver: SolverArg,
+    /// Control rate (Hz); default: [runtime] rate_hz of the config, else 500.
+    #[arg(long, value_name = "F")]
+    pub rate_hz: Option<f64>,
+    /// Seed of the stance generator.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Write a sample of the solved QPs (JSON array, see daemon::qp::export_json) to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub export_qp: Option<PathBuf>,
+}
+
+/// Runs `walkd bench`: exit 0 when the walk reached `done`, 1 when it did not, 2 on bad input.
+pub fn main(args: &BenchArgs) -> ExitCode {
+    match run(args) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(1),
+        Err(error) => {
+            eprintln!("walkd bench: {error:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Latency histograms (ns) of the walk.
+struct Timing {
+    tick: Histogram<u64>,
+    qp: Histogram<u64>,
+}
+
+impl Timing {
+    fn new() -> anyhow::Result<Self> {
+        Ok(Self {
+            tick: Histogram::new_with_bounds(1, 10_000_000_000, 3)?,
+            qp: Histogram::new_with_bounds(1, 10_000_000_000, 3)?,
+        })
+    }
+}
+
+fn run(args: &BenchArgs) -> anyhow::Result<bool> {
+    let robot = Arc::new(
+        Robot::load(&args.robot, args.urdf.as_deref())
+            .with_context(|| format!("loading robot {}", args.robot.display()))?,
+    );
+    let params = PostProcessParams::from_config_path(&args.robot)?;
+    let config = ControllerConfig::from_config_file(&args.robot)?;
+    let rate_hz = match args.rate_hz {
+        Some(rate) => rate,
+        None => runtime_rate(&args.robot)?.unwrap_or(DEFAULT_RATE_HZ),
+    };
+    anyhow::ensure!(
+        rate_hz.is_finite() && rate_hz > 0.0,
+        "--rate-hz {rate_hz}: must be a positive number"
+    );
+    let raw = stance::generate(
+        &robot,
+        &GenerateOptions {
+            distance: args.distance / params.scf,
+            affordances: args.affordances,
+            seed: args.seed,
+        },
+    )
+    .context("generating the stance sequence")?;
+    let sequence = PostProcessor::new(&robot, params)
+        .process(&raw)
+        .context("post-processing the stance sequence")?;
+    let solver_kind = SolverKind::from(args.solver);
+    let options = WalkOptions {
+        solver: solver_kind,
+        rate_hz,
+        time_limit_s: 60.0 + 20.0 * sequence.len() as f64,
+    };
+    let mut timing = Timing::new()?;
+    let mut timing_solver: Box<dyn QpSolver> = match solver_kind {
+        SolverKind::Dense => {
+            let n = robot.model.nv();
+            let p = crate::controller::Controller::qp_capacity();
+            Box::new(DenseActiveSetSolver::new(n, p.0, p.1))
+        }
+        SolverKind::Clarabel => Box::new(ClarabelSolver::new()),
+    };
+    let mut solution = vec![0.0; robot.model.nv()];
+    let mut exported = Vec::new();
+    let mut executing_ticks = 0u64;
+    let report = walk(robot.clone(), config, &sequence, &options, |o| {
+        timing.tick.saturating_record(o.tick_ns.max(1));
+        if o.status.state != ControllerState::Executing {
+            return;
+        }
+        let problem = o.controller.last_problem();
+        let started = Instant::now();
+        let solved = timing_solver.solve(problem, &mut solution).is_ok();
+        let qp_ns = started.elapsed().as_nanos() as u64;
+        if solved {
+            timing.qp.saturating_record(qp_ns.max(1));
+        }
+        if args.export_qp.is_some()
+            && executing_ticks % EXPORT_EVERY == 0
+            && exported.len() < EXPORT_MAX
+        {
+            exported.push(export_json(problem));
+        }
+        executing_ticks += 1;
+    })?;
+    if let Some(path) = &args.export_qp {
+        std::fs::write(path, serde_json::to_string(&exported)?)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    print_report(args, &robot, solver_kind, rate_hz, &report, &timing);
+    Ok(report.outcome == Outcome::Done)
+}
+
+/// `[runtime] rate_hz` of the config, if set.
+fn runtime_rate(path: &Path) -> anyhow::Result<Option<f64>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let table: toml::Table = text
+        .parse()
+        .with_context(|| format!("parsing {}", path.display()))?;
+    Ok(table
+        .get("runtime")
+        .and_then(|r| r.get("rate_hz"))
+        .and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64))))
+}
+
+fn micros(h: &Histogram<u64>, quantile: f64) -> f64 {
+    if h.is_empty() {
+        return 0.0;
+    }
+    let ns = if quantile >= 1.0 {
+        h.max()
+    } else {
+        h.value_at_quantile(quantile)
+    };
+    (ns as f64 / 1000.0 * 100.0).round() / 100.0
+}
+
+/// Latency percentiles in microseconds.
+#[derive(serde::Serialize)]
+struct Quantiles {
+    p50: f64,
+    p99: f64,
+    max: f64,
+}
+
+impl Quantiles {
+    fn of(h: &Histogram<u64>) -> Self {
+        Self {
+            p50: micros(h, 0.5),
+            p99: micros(h, 0.99),
+            max: micros(h, 1.0),
+        }
+    }
+}
+
+/// The `--json` report, fields in the documented order.
+#[derive(serde::Serialize)]
+struct JsonReport {
+    outcome: String,
+    stances: usize,
+    ticks: u64,
+    tick_us: Quantiles,
+    qp_us: Quantiles,
+    min_stability_margin_m: f64,
+    max_contact_slip_m: f64,
+    joint_limit_violations: u64,
+    distance_m: f64,
+}
+
+fn print_report(
+    args: &BenchArgs,
+    robot: &Robot,
+    solver: SolverKind,
+    rate_hz: f64,
+    report: &WalkReport,
+    timing: &Timing,
+) {
+    let safety = &report.safety;
+    if args.json {
+        let value = JsonReport {
+            outcome: report.outcome.label(),
+            stances: report.stances,
+            ticks: report.ticks,
+            tick_us: Quantiles::of(&timing.tick),
+            qp_us: Quantiles::of(&timing.qp),
+            min_stability_margin_m: safety.min_stability_margin,
+            max_contact_slip_m: safety.max_contact_slip,
+            joint_limit_violations: safety.joint_limit_violations,
+            distance_m: report.distance_m,
+        };
+        match serde_json::to_string(&value) {
+            Ok(line) => println!("{line}"),
+            Err(error) => eprintln!("walkd bench: cannot write the JSON report: {error}"),
+        }
+        return;
+    }
+    println!(
+        "walkd bench: {} ({}), {} m requested, affordances {}, solver {}, {} Hz",
+        robot.name,
+        args.robot.display(),
+        args.distance,
+        args.affordances,
+        solver.name(),
+        rate_hz
+    );
+    println!("  outcome                {}", report.outcome.label());
+    println!(
+        "  stances                {} in {} ticks ({:.1} s simulated)",
+        report.stances,
+        report.ticks,
+        report.ticks as f64 / rate_hz
+    );
+    println!("  distance walked        {:.3} m", report.distance_m);
+    for (name, h) in [("tick", &timing.tick), ("qp solve", &timing.qp)] {
+        println!(
+            "  {name:<22} p50 {:.2} µs  p99 {:.2} µs  max {:.2} µs",
+            micros(h, 0.5),
+            micros(h, 0.99),
+            micros(h, 1.0)
+        );
+    }
+    println!(
+        "  min stability margin   {:.4} m",
+        safety.min_stability_margin
+    );
+    println!("  max contact slip       {:.6} m", safety.max_contact_slip);
+    println!("  max penetration        {:.6} m", safety.max_penetration);
+    println!("  joint limit violations {}", safety.joint_limit_violations);
+}

@@ -1,0 +1,305 @@
+//! Builds the tick's QP over ν = (v_base, ω_base, q̇) from the tasks and constraints:
+//!
+//! ```text
+//! min  Σ_k w_k ‖J_k ν − v*_k‖² + λ‖ν‖²        v*_k = feed-forward + K_k · error_k
+//! s.t. J_c ν = 0                               feet in contact
+//!      n_eᵀ J_com,xy ν ≤ k_s (d_e − m − n_eᵀ c) CoM stays in the support polygon shrunk by m
+//!      q̇ within velocity limits and (q_min + margin − q)/dt ≤ q̇ ≤ (q_max − margin − q)/dt
+//! ```
+//!
+//! Tasks: CoM x/y, end-effector poses, upright base, posture. Jacobian blocks are accumulated
+//! over their structurally non-zero columns only, so a foot task costs a few hundred flops.
+//! Everything is preallocated at construction.
+
+use kinematics::configuration::Configuration;
+use kinematics::kinematics::Kinematics;
+use kinematics::robot::{EndEffector, Robot};
+use nalgebra::{DMatrix, DVector, Isometry3, UnitQuaternion, Vector3};
+
+use kinematic_sim::support::{MAX_SUPPORT_POINTS, SupportPolygon, sole_corners};
+
+use super::config::ControllerConfig;
+use super::machine::{PoseTarget, Targets};
+use crate::qp::QpProblem;
+
+/// Equality rows: six per foot in contact.
+pub(crate) const MAX_EQUALITY_ROWS: usize = 12;
+/// Inequality rows: one per support polygon edge.
+pub(crate) const MAX_INEQUALITY_ROWS: usize = MAX_SUPPORT_POINTS;
+
+/// Preallocated QP and the Jacobian scratch used to fill it.
+pub(crate) struct QpAssembler {
+    problem: QpProblem,
+    jacobian: DMatrix<f64>,
+    com_jacobian: DMatrix<f64>,
+    /// Structurally non-zero Jacobian columns of each end-effector frame.
+    columns: [Vec<usize>; 4],
+    all_columns: Vec<usize>,
+    /// Base orientation of the standing posture: "upright" means no roll/pitch relative to it.
+    upright_reference: UnitQuaternion<f64>,
+    polygon: SupportPolygon,
+    corners: [[f64; 2]; MAX_SUPPORT_POINTS],
+}
+
+impl QpAssembler {
+    pub fn new(robot: &Robot) -> Self {
+        let model = &robot.model;
+        let nv = model.nv();
+        let mut jacobian = DMatrix::zeros(6, nv);
+        // Columns that are zero at two unrelated configurations are zero structurally (the
+        // joint is not on the frame's chain).
+        let mut kinematics = Kinematics::new(model);
+        let mut probe = robot.standing.clone();
+        let mut nonzero = [
+            vec![false; nv],
+            vec![false; nv],
+            vec![false; nv],
+            vec![false; nv],
+        ];
+        for offset in [0.0, 0.3] {
+            for (j, limit) in model.joint_limits().iter().enumerate() {
+                let q = robot.standing.joints[j] + offset * (1.0 + 0.1 * j as f64).sin();
+                probe.joints[j] = q.clamp(limit.lower, limit.upper);
+            }
+            kinematics.update(model, &probe);
+            for e in EndEffector::ALL {
+                kinematics.frame_jacobian(model, robot.frame(e), &mut jacobian);
+                for (col, flag) in nonzero[e as usize].iter_mut().enumerate() {
+                    *flag |= jacobian.column(col).iter().any(|v| *v != 0.0);
+                }
+            }
+        }
+        let columns = nonzero.map(|flags| {
+            flags
+                .iter()
+                .enumerate()
+                .filter(|(col, flag)| **flag || *col < 6)
+                .map(|(col, _)| col)
+                .collect()
+        });
+        Self {
+            problem: QpProblem::new(nv, MAX_EQUALITY_ROWS, MAX_INEQUALITY_ROWS),
+            jacobian,
+            com_jacobian: DMatrix::zeros(3, nv),
+            columns,
+            all_columns: (0..nv).collect(),
+            upright_reference: robot.standing.base.rotation,
+            polygon: SupportPolygon::empty(),
+            corners: [[0.0; 2]; MAX_SUPPORT_POINTS],
+        }
+    }
+
+    /// The QP of the last [`assemble`](Self::assemble).
+    pub fn problem(&self) -> &QpProblem {
+        &self.problem
+    }
+
+    /// Fills the QP for this tick. `kinematics` must be updated at `configuration`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn assemble(
+        &mut self,
+        robot: &Robot,
+        config: &ControllerConfig,
+        kinematics: &Kinematics,
+        configuration: &Configuration,
+        targets: &Targets,
+        posture: &DVector<f64>,
+        dt: f64,
+    ) {
+        let model = &robot.model;
+        let nv = model.nv();
+        let feet_in_contact = [EndEffector::LeftFoot, EndEffector::RightFoot]
+            .iter()
+            .filter(|f| targets.contacts[**f as usize])
+            .count();
+        self.polygon_from_contacts(robot, targets);
+        let m_ineq = self.polygon.edge_count();
+        self.problem
+            .set_active_rows(6 * feet_in_contact, m_ineq)
+            .expect("row counts within the preallocated capacity");
+        let qp = self.problem.parts_mut();
+        let (mut p, mut q) = (qp.p, qp.q);
+        p.fill(0.0);
+        q.fill(0.0);
+        for i in 0..nv {
+            p[(i, i)] = config.regularization;
+        }
+
+        // CoM x/y.
+        kinematics.com_jacobian(model, &mut self.com_jacobian);
+        let com = kinematics.com();
+        let com_velocity = [
+            targets.com_velocity.x + config.com_gain * (targets.com.x - com.x),
+            targets.com_velocity.y + config.com_gain * (targets.com.y - com.y),
+        ];
+        add_task(
+            &mut p,
+            &mut q,
+            &self.com_jacobian,
+            2,
+            &self.all_columns,
+            config.com_weight,
+            &com_velocity,
+        );
+
+        // End-effector poses (feet in contact are constrained below instead).
+        for e in EndEffector::ALL {
+            let Some(target) = targets.end_effectors[e as usize] else {
+                continue;
+            };
+            let frame = robot.frame(e);
+            kinematics.frame_jacobian(model, frame, &mut self.jacobian);
+            let pose = kinematics.frame_pose(model, frame);
+            let desired = pose_velocity(&pose, &target, config.pose_gain);
+            let weight = if e.is_foot() {
+                config.foot_weight
+            } else {
+                config.hand_weight
+            };
+            add_task(
+                &mut p,
+                &mut q,
+                &self.jacobian,
+                6,
+                &self.columns[e as usize],
+                weight,
+                &desired,
+            );
+        }
+
+        // Upright base: no roll or pitch relative to the standing orientation, yaw left free.
+        // The base Jacobian's angular rows are the identity on ω.
+        let relative = configuration.base.rotation * self.upright_reference.inverse();
+        let (_, _, yaw) = relative.euler_angles();
+        let upright = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw);
+        let tilt = (upright * relative.inverse()).scaled_axis();
+        for k in 0..3 {
+            p[(3 + k, 3 + k)] += config.torso_weight;
+            q[3 + k] -= config.torso_weight * config.torso_gain * tilt[k];
+        }
+
+        // Posture.
+        for j in 0..model.dof() {
+            let error = posture[j] - configuration.joints[j];
+            p[(6 + j, 6 + j)] += config.posture_weight;
+            q[6 + j] -= config.posture_weight * config.posture_gain * error;
+        }
+
+        // Feet in contact do not move: J_c ν = K (anchor − pose), which is 0 while the estimate
+        // agrees with the anchor and pulls back the second-order drift of J_c ν = 0 otherwise.
+        let (mut a_eq, mut b_eq) = (qp.a_eq, qp.b_eq);
+        let mut row = 0;
+        for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
+            if !targets.contacts[foot as usize] {
+                continue;
+            }
+            let frame = robot.frame(foot);
+            kinematics.frame_jacobian(model, frame, &mut self.jacobian);
+            a_eq.rows_mut(row, 6).copy_from(&self.jacobian);
+            let hold = PoseTarget {
+                pose: targets.anchors[foot as usize],
+                velocity: [0.0; 6],
+            };
+            let correction = pose_velocity(
+                &kinematics.frame_pose(model, frame),
+                &hold,
+                config.pose_gain,
+            );
+            for (k, value) in correction.iter().enumerate() {
+                b_eq[row + k] = *value;
+            }
+            row += 6;
+        }
+
+        // CoM ground projection inside the shrunk support polygon.
+        let (mut c, mut l, mut u) = (qp.c, qp.l, qp.u);
+        for i in 0..m_ineq {
+            let edge = self.polygon.edge(i);
+            for col in 0..nv {
+                c[(i, col)] = edge.normal[0] * self.com_jacobian[(0, col)]
+                    + edge.normal[1] * self.com_jacobian[(1, col)];
+            }
+            let slack = edge.offset
+                - config.support_margin_m
+                - (edge.normal[0] * com.x + edge.normal[1] * com.y);
+            l[i] = f64::NEG_INFINITY;
+            u[i] = config.support_gain.min(1.0 / dt) * slack;
+        }
+
+        // Velocity and position limits.
+        let (mut x_min, mut x_max) = (qp.x_min, qp.x_max);
+        for k in 0..6 {
+            x_min[k] = -config.max_base_speed;
+            x_max[k] = config.max_base_speed;
+        }
+        for (j, limit) in model.joint_limits().iter().enumerate() {
+            let speed = config.velocity_limit_scale * limit.velocity;
+            let qj = configuration.joints[j];
+            let lower = (-speed).max((limit.lower + config.joint_limit_margin_rad - qj) / dt);
+            let upper = speed.min((limit.upper - config.joint_limit_margin_rad - qj) / dt);
+            // Outside the margin the bound pulls back inside; never cross the bounds.
+            x_min[6 + j] = lower.min(upper);
+            x_max[6 + j] = upper.max(lower);
+        }
+    }
+
+    /// Hull of the sole corners of the feet in contact (at their anchors).
+    fn polygon_from_contacts(&mut self, robot: &Robot, targets: &Targets) {
+        let mut count = 0;
+        for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
+            if !targets.contacts[foot as usize] {
+                continue;
+            }
+            for corner in sole_corners(&targets.anchors[foot as usize], &robot.sole) {
+                self.corners[count] = [corner.x, corner.y];
+                count += 1;
+            }
+        }
+        self.polygon.set_hull(&self.corners[..count]);
+    }
+}
+
+/// Desired frame velocity: feed-forward plus proportional correction of the pose error.
+fn pose_velocity(pose: &Isometry3<f64>, target: &PoseTarget, gain: f64) -> [f64; 6] {
+    let position_error = target.pose.translation.vector - pose.translation.vector;
+    let rotation_error: Vector3<f64> =
+        (target.pose.rotation * pose.rotation.inverse()).scaled_axis();
+    let mut desired = target.velocity;
+    for k in 0..3 {
+        desired[k] += gain * position_error[k];
+        desired[3 + k] += gain * rotation_error[k];
+    }
+    desired
+}
+
+/// Adds `w ‖J ν − v*‖²` (first `rows` rows of `jacobian`, non-zero `columns` only):
+/// P += w JᵀJ, q −= w Jᵀ v*.
+fn add_task(
+    p: &mut nalgebra::DMatrixViewMut<'_, f64>,
+    q: &mut nalgebra::DVectorViewMut<'_, f64>,
+    jacobian: &DMatrix<f64>,
+    rows: usize,
+    columns: &[usize],
+    weight: f64,
+    desired: &[f64],
+) {
+    for (a, &ca) in columns.iter().enumerate() {
+        let col_a = jacobian.column(ca);
+        let mut rhs = 0.0;
+        for r in 0..rows {
+            rhs += col_a[r] * desired[r];
+        }
+        q[ca] -= weight * rhs;
+        for &cb in &columns[..=a] {
+            let col_b = jacobian.column(cb);
+            let mut dot = 0.0;
+            for r in 0..rows {
+                dot += col_a[r] * col_b[r];
+            }
+            p[(ca, cb)] += weight * dot;
+            if ca != cb {
+                p[(cb, ca)] += weight * dot;
+            }
+        }
+    }
+}

@@ -1,0 +1,311 @@
+//! The `[controller]` section of a robot config: task weights and gains, limits margins,
+//! trajectory speeds, tolerances, contact thresholds and timeouts.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+/// Controller tuning from the `[controller]` section; every key is optional (defaults below suit
+/// the vendored humanoids) and an unknown key is an error naming the file and key.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ControllerConfig {
+    /// Weight of the CoM x/y task.
+    pub com_weight: f64,
+    /// Weight of a swinging foot's pose task.
+    pub foot_weight: f64,
+    /// Weight of a hand's pose task (reaching or holding a hand contact).
+    pub hand_weight: f64,
+    /// Weight of the upright base-orientation task.
+    pub torso_weight: f64,
+    /// Weight of the posture task towards the stance's joint angles (low: moves the upper body).
+    pub posture_weight: f64,
+    /// λ of the λ‖ν‖² regulariser that keeps P positive definite.
+    pub regularization: f64,
+    /// Proportional gain of the CoM task (1/s).
+    pub com_gain: f64,
+    /// Proportional gain of the foot and hand pose tasks (1/s).
+    pub pose_gain: f64,
+    /// Proportional gain of the upright task (1/s).
+    pub torso_gain: f64,
+    /// Proportional gain of the posture task (1/s).
+    pub posture_gain: f64,
+    /// Joints are kept this far inside their position limits (rad).
+    pub joint_limit_margin_rad: f64,
+    /// Fraction of each joint's URDF velocity limit the QP may use.
+    pub velocity_limit_scale: f64,
+    /// Bound on each base velocity component (m/s, rad/s).
+    pub max_base_speed: f64,
+    /// The CoM ground projection stays this far inside the support polygon (m).
+    pub support_margin_m: f64,
+    /// Rate at which the CoM may approach the shrunk support polygon's edge (1/s).
+    pub support_gain: f64,
+    /// Average CoM speed of a CoM shift (m/s).
+    pub com_speed: f64,
+    /// Average foot/hand speed of a swing or reach (m/s).
+    pub swing_speed: f64,
+    /// Average angular speed of a swing or reach (rad/s).
+    pub swing_angular_speed: f64,
+    /// Shortest duration of any trajectory (s).
+    pub min_motion_s: f64,
+    /// Height of the vertical lift after unloading a foot (m).
+    pub lift_height_m: f64,
+    /// The swing ends this far above the next contact pose before lowering (m).
+    pub approach_height_m: f64,
+    /// Speed of the final descent onto the contact (m/s).
+    pub lower_speed: f64,
+    /// How far below the contact pose the descent target goes until touchdown is confirmed (m).
+    pub lower_overshoot_m: f64,
+    /// How far the unloading foot is raised while its load drops (m).
+    pub unload_lift_m: f64,
+    /// CoM position tolerance (m).
+    pub com_tolerance_m: f64,
+    /// End-effector position tolerance (m).
+    pub position_tolerance_m: f64,
+    /// End-effector orientation tolerance (rad).
+    pub orientation_tolerance_rad: f64,
+    /// Position tolerance of a swing's via pose (the stance's swing pose, not a contact) (m).
+    pub via_position_tolerance_m: f64,
+    /// Orientation tolerance of a swing's via pose (rad).
+    pub via_orientation_tolerance_rad: f64,
+    /// Position tolerance of a hand contact (the kinematic simulator models no hand support) (m).
+    pub hand_position_tolerance_m: f64,
+    /// Orientation tolerance of a hand contact (rad).
+    pub hand_orientation_tolerance_rad: f64,
+    /// A foot is released when its FT normal force drops below this fraction of the weight.
+    pub release_force_fraction: f64,
+    /// A touchdown is confirmed when the FT normal force exceeds this fraction of the weight ...
+    pub touchdown_force_fraction: f64,
+    /// ... for this many consecutive ticks.
+    pub touchdown_debounce_ticks: u32,
+    /// Time allowed beyond a phase's planned duration before it is a fault (s).
+    pub phase_timeout_s: f64,
+    /// Longest step between consecutive contacts of one foot that a sequence may ask for (m).
+    pub max_step_m: f64,
+}
+
+impl Default for ControllerConfig {
+    fn default() -> Self {
+        Self {
+            com_weight: 10.0,
+            foot_weight: 10.0,
+            hand_weight: 1.0,
+            torso_weight: 1.0,
+            posture_weight: 1e-2,
+            regularization: 1e-5,
+            com_gain: 10.0,
+            pose_gain: 20.0,
+            torso_gain: 10.0,
+            posture_gain: 2.0,
+            joint_limit_margin_rad: 0.02,
+            velocity_limit_scale: 0.5,
+            max_base_speed: 1.0,
+            support_margin_m: 0.02,
+            support_gain: 20.0,
+            com_speed: 0.05,
+            swing_speed: 0.15,
+            swing_angular_speed: 0.5,
+            min_motion_s: 0.3,
+            lift_height_m: 0.03,
+            approach_height_m: 0.02,
+            lower_speed: 0.02,
+            lower_overshoot_m: 0.003,
+            unload_lift_m: 0.002,
+            com_tolerance_m: 0.005,
+            position_tolerance_m: 0.005,
+            orientation_tolerance_rad: 0.05,
+            via_position_tolerance_m: 0.03,
+            via_orientation_tolerance_rad: 0.2,
+            hand_position_tolerance_m: 0.03,
+            hand_orientation_tolerance_rad: 0.1,
+            release_force_fraction: 0.1,
+            touchdown_force_fraction: 0.1,
+            touchdown_debounce_ticks: 3,
+            phase_timeout_s: 5.0,
+            max_step_m: 0.5,
+        }
+    }
+}
+
+/// Why the `[controller]` section could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The config file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML.
+    #[error("{path}: invalid TOML: {source}")]
+    Toml {
+        /// The config file.
+        path: PathBuf,
+        /// The parse error.
+        source: toml::de::Error,
+    },
+    /// The `[controller]` section is missing, has an unknown key or a badly typed value.
+    #[error("{origin}: [controller]: {message}")]
+    Section {
+        /// File (or "<table>") the section came from.
+        origin: String,
+        /// What is wrong, naming the key.
+        message: String,
+    },
+    /// A value is out of its meaningful range.
+    #[error("{origin}: [controller] {key} = {value}: {requirement}")]
+    Value {
+        /// File (or "<table>") the section came from.
+        origin: String,
+        /// The offending key.
+        key: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must satisfy.
+        requirement: &'static str,
+    },
+}
+
+impl ControllerConfig {
+    /// Reads the `[controller]` section of a robot config file.
+    pub fn from_config_file(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        let table: toml::Table = text.parse().map_err(|source| ConfigError::Toml {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::from_section(&table, &path.display().to_string())
+    }
+
+    /// Reads the `[controller]` section of an already parsed robot config.
+    pub fn from_toml_table(table: &toml::Table) -> Result<Self, ConfigError> {
+        Self::from_section(table, "<table>")
+    }
+
+    fn from_section(table: &toml::Table, origin: &str) -> Result<Self, ConfigError> {
+        let section = table
+            .get("controller")
+            .ok_or_else(|| ConfigError::Section {
+                origin: origin.to_owned(),
+                message: "section missing".to_owned(),
+            })?;
+        let config: Self =
+            section
+                .clone()
+                .try_into()
+                .map_err(|e: toml::de::Error| ConfigError::Section {
+                    origin: origin.to_owned(),
+                    message: e.message().to_owned(),
+                })?;
+        config.validate(origin)?;
+        Ok(config)
+    }
+
+    /// Checks every value is finite and in range; `origin` names the file in the error.
+    pub fn validate(&self, origin: &str) -> Result<(), ConfigError> {
+        let positive = [
+            ("com_weight", self.com_weight),
+            ("foot_weight", self.foot_weight),
+            ("hand_weight", self.hand_weight),
+            ("torso_weight", self.torso_weight),
+            ("posture_weight", self.posture_weight),
+            ("regularization", self.regularization),
+            ("com_gain", self.com_gain),
+            ("pose_gain", self.pose_gain),
+            ("torso_gain", self.torso_gain),
+            ("posture_gain", self.posture_gain),
+            ("max_base_speed", self.max_base_speed),
+            ("support_gain", self.support_gain),
+            ("com_speed", self.com_speed),
+            ("swing_speed", self.swing_speed),
+            ("swing_angular_speed", self.swing_angular_speed),
+            ("min_motion_s", self.min_motion_s),
+            ("lift_height_m", self.lift_height_m),
+            ("lower_speed", self.lower_speed),
+            ("com_tolerance_m", self.com_tolerance_m),
+            ("position_tolerance_m", self.position_tolerance_m),
+            ("orientation_tolerance_rad", self.orientation_tolerance_rad),
+            ("via_position_tolerance_m", self.via_position_tolerance_m),
+            (
+                "via_orientation_tolerance_rad",
+                self.via_orientation_tolerance_rad,
+            ),
+            ("hand_position_tolerance_m", self.hand_position_tolerance_m),
+            (
+                "hand_orientation_tolerance_rad",
+                self.hand_orientation_tolerance_rad,
+            ),
+            ("phase_timeout_s", self.phase_timeout_s),
+            ("max_step_m", self.max_step_m),
+        ];
+        let non_negative = [
+            ("joint_limit_margin_rad", self.joint_limit_margin_rad),
+            ("support_margin_m", self.support_margin_m),
+            ("approach_height_m", self.approach_height_m),
+            ("lower_overshoot_m", self.lower_overshoot_m),
+            ("unload_lift_m", self.unload_lift_m),
+        ];
+        let fractions = [
+            ("velocity_limit_scale", self.velocity_limit_scale),
+            ("release_force_fraction", self.release_force_fraction),
+            ("touchdown_force_fraction", self.touchdown_force_fraction),
+        ];
+        let fail = |key, value, requirement| ConfigError::Value {
+            origin: origin.to_owned(),
+            key,
+            value,
+            requirement,
+        };
+        for (key, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(fail(key, value, "must be finite and > 0"));
+            }
+        }
+        for (key, value) in non_negative {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(fail(key, value, "must be finite and >= 0"));
+            }
+        }
+        for (key, value) in fractions {
+            if !(value > 0.0 && value <= 1.0) {
+                return Err(fail(key, value, "must be in (0, 1]"));
+            }
+        }
+        if self.touchdown_debounce_ticks == 0 {
+            return Err(fail("touchdown_debounce_ticks", 0.0, "must be >= 1"));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_key_is_an_error_naming_it() {
+        let table: toml::Table = "[controller]\ncom_wieght = 1.0\n".parse().unwrap();
+        let error = ControllerConfig::from_toml_table(&table)
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("com_wieght"), "{error}");
+    }
+
+    #[test]
+    fn partial_section_keeps_defaults_and_bad_values_are_named() {
+        let table: toml::Table = "[controller]\ncom_weight = 3.0\n".parse().unwrap();
+        let config = ControllerConfig::from_toml_table(&table).unwrap();
+        assert_eq!(config.com_weight, 3.0);
+        assert_eq!(config.foot_weight, ControllerConfig::default().foot_weight);
+        let table: toml::Table = "[controller]\nlower_speed = -1.0\n".parse().unwrap();
+        let error = ControllerConfig::from_toml_table(&table)
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("lower_speed"), "{error}");
+    }
+}

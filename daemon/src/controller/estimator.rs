@@ -1,0 +1,109 @@
+//! Floating-base estimation by leg odometry: the feet in contact are anchored in the world, so the
+//! base pose follows from the measured joint angles; an IMU, when present, gives the orientation.
+
+use kinematics::configuration::Configuration;
+use kinematics::kinematics::Kinematics;
+use kinematics::robot::{EndEffector, Robot};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+
+use kinematic_sim::support::sole_corners;
+
+/// Feet closer than this to the lowest sole when the world frame is set up count as standing (m).
+const STANDING_TOLERANCE: f64 = 2e-3;
+
+/// Estimates the base pose from anchored feet; holds no state besides the last estimate.
+#[derive(Debug, Clone)]
+pub(crate) struct BaseEstimator {
+    base: Isometry3<f64>,
+}
+
+impl BaseEstimator {
+    pub fn new(initial: Isometry3<f64>) -> Self {
+        Self { base: initial }
+    }
+
+    /// Sets up the world frame on the first measurement: the configured standing base pose (its
+    /// orientation from the IMU if any), lowered or raised so the lowest sole corner is on the
+    /// ground z = 0. Returns which feet stand (within a tolerance of the lowest sole).
+    pub fn initialise(
+        &mut self,
+        robot: &Robot,
+        kinematics: &mut Kinematics,
+        configuration: &mut Configuration,
+        imu: Option<UnitQuaternion<f64>>,
+    ) -> [bool; 2] {
+        configuration.base = robot.standing.base;
+        if let Some(orientation) = imu {
+            configuration.base.rotation = orientation;
+        }
+        kinematics.update(&robot.model, configuration);
+        let lowest = [EndEffector::LeftFoot, EndEffector::RightFoot].map(|foot| {
+            let pose = kinematics.frame_pose(&robot.model, robot.frame(foot));
+            sole_corners(&pose, &robot.sole)
+                .iter()
+                .map(|c| c.z)
+                .fold(f64::INFINITY, f64::min)
+        });
+        let ground = lowest[0].min(lowest[1]);
+        configuration.base.translation.vector.z -= ground;
+        kinematics.update(&robot.model, configuration);
+        self.base = configuration.base;
+        lowest.map(|z| z - ground <= STANDING_TOLERANCE)
+    }
+
+    /// Estimates the base from the anchored feet (`anchors[i]` for left/right foot, weighted by
+    /// `weights`) and updates `kinematics` at the estimate. Returns `false` when no foot is
+    /// anchored (the base is then kept).
+    pub fn update(
+        &mut self,
+        robot: &Robot,
+        kinematics: &mut Kinematics,
+        configuration: &mut Configuration,
+        anchors: [Option<&Isometry3<f64>>; 2],
+        weights: [f64; 2],
+        imu: Option<UnitQuaternion<f64>>,
+    ) -> bool {
+        configuration.base = self.base;
+        kinematics.update(&robot.model, configuration);
+        let inverse_base = self.base.inverse();
+        let mut total_weight = 0.0;
+        let mut translation = Vector3::zeros();
+        let mut rotation: Option<UnitQuaternion<f64>> = imu;
+        for (slot, foot) in [EndEffector::LeftFoot, EndEffector::RightFoot]
+            .iter()
+            .enumerate()
+        {
+            let Some(anchor) = anchors[slot] else {
+                continue;
+            };
+            let foot_in_base =
+                inverse_base * kinematics.frame_pose(&robot.model, robot.frame(*foot));
+            let candidate = anchor * foot_in_base.inverse();
+            let weight = weights[slot].max(1e-6);
+            if imu.is_none() {
+                rotation = Some(match rotation {
+                    None => candidate.rotation,
+                    Some(r) => r.nlerp(&candidate.rotation, weight / (total_weight + weight)),
+                });
+            }
+            let t = match imu {
+                // With the IMU orientation fixed, the foot gives the translation alone.
+                Some(r) => anchor.translation.vector - r * foot_in_base.translation.vector,
+                None => candidate.translation.vector,
+            };
+            translation += weight * t;
+            total_weight += weight;
+        }
+        let Some(rotation) = rotation.filter(|_| total_weight > 0.0) else {
+            return false;
+        };
+        // Renormalise: composing with inverses assumes unit quaternions, and a norm error would
+        // double every tick through the estimate's feedback.
+        let mut rotation = rotation;
+        rotation.renormalize();
+        self.base = Isometry3::from_parts(Translation3::from(translation / total_weight), rotation);
+        configuration.base = self.base;
+        kinematics.update(&robot.model, configuration);
+        true
+    }
+}

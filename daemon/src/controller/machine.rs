@@ -1,0 +1,561 @@
+//! The stance state machine: walks through the transitions of a [`PreparedSequence`], phase by
+//! phase, and produces the task set-points and the contact set of every tick.
+//!
+//! Contacts change only here: a foot leaves the contact set when its unloading starts and joins
+//! it when force-torque confirms touchdown (debounced), so the QP's contact constraints always
+//! agree with the state machine. Every phase has a planned duration; exceeding it by the
+//! configured timeout is a fault.
+
+use kinematic_sim::support::{SupportPolygon, sole_corners};
+use kinematics::robot::{EndEffector, SoleRectangle};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
+
+use super::config::ControllerConfig;
+use super::plan::{Step, TransitionPlan};
+use super::sequence::PreparedSequence;
+use super::status::{FaultCode, Phase};
+use super::trajectory::{PointTrajectory, PoseTrajectory, Profile};
+
+const FEET: [EndEffector; 2] = [EndEffector::LeftFoot, EndEffector::RightFoot];
+
+/// What the state machine needs to know about the robot this tick (estimated, world frame).
+pub(crate) struct Feedback<'a> {
+    /// Centre of mass.
+    pub com: Vector3<f64>,
+    /// End-effector poses by `EndEffector`.
+    pub poses: &'a [Isometry3<f64>; 4],
+    /// FT normal (world z) force by `EndEffector` (N).
+    pub normal_forces: [f64; 4],
+}
+
+/// A pose set-point with its feed-forward velocity (linear xyz, angular xyz, world).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PoseTarget {
+    pub pose: Isometry3<f64>,
+    pub velocity: [f64; 6],
+}
+
+/// The set-points and contact set for one tick's QP.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Targets {
+    /// End-effectors in contact (feet: equality constraints; hands: held pose tasks).
+    pub contacts: [bool; 4],
+    /// World pose of each end-effector in contact (valid where `contacts`).
+    pub anchors: [Isometry3<f64>; 4],
+    /// CoM x/y set-point and its feed-forward velocity.
+    pub com: Vector2<f64>,
+    pub com_velocity: Vector2<f64>,
+    /// Pose tasks (None: no task; feet in contact are constrained instead).
+    pub end_effectors: [Option<PoseTarget>; 4],
+}
+
+/// Result of one state-machine update.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Progress {
+    Running,
+    Done,
+    Fault(FaultCode),
+}
+
+/// A CoM shift that stalled short of its goal (joint limits) still completes once it has sat
+/// this long (s) past its planned duration inside the support it prepares, shrunk by the support
+/// margin plus the CoM tolerance.
+const COM_SETTLE_S: f64 = 0.5;
+
+/// Execution state of the current sequence.
+pub(crate) struct StateMachine {
+    config: ControllerConfig,
+    sole: SoleRectangle,
+    /// The support the current CoM shift prepares (the feet staying in contact).
+    com_support: SupportPolygon,
+    release_force: f64,
+    touchdown_force: f64,
+    sequence: Option<Box<PreparedSequence>>,
+    started: bool,
+    to_world: Isometry3<f64>,
+    stance: usize,
+    plan: TransitionPlan,
+    step: usize,
+    phase_time: f64,
+    deadline: f64,
+    debounce: u32,
+    motion: PoseTrajectory,
+    /// Whether the current motion ends at a via pose (a swing apex) rather than an approach.
+    motion_is_via: bool,
+    com_motion: PointTrajectory,
+    com_time: f64,
+    free_targets: [Option<Isometry3<f64>>; 4],
+    targets: Targets,
+}
+
+impl StateMachine {
+    /// A machine for a robot of weight `weight_n` (N): thresholds are fractions of it.
+    pub fn new(config: &ControllerConfig, sole: SoleRectangle, weight_n: f64) -> Self {
+        Self {
+            config: *config,
+            sole,
+            com_support: SupportPolygon::empty(),
+            release_force: config.release_force_fraction * weight_n,
+            touchdown_force: config.touchdown_force_fraction * weight_n,
+            sequence: None,
+            started: false,
+            to_world: Isometry3::identity(),
+            stance: 0,
+            plan: TransitionPlan::new([false; 4], [false; 4], false),
+            step: 0,
+            phase_time: 0.0,
+            deadline: f64::INFINITY,
+            debounce: 0,
+            motion: PoseTrajectory::hold(Isometry3::identity()),
+            motion_is_via: false,
+            com_motion: PointTrajectory::new(Vector2::zeros(), Vector2::zeros(), 1.0),
+            com_time: 0.0,
+            free_targets: [None; 4],
+            targets: Targets {
+                contacts: [false; 4],
+                anchors: [Isometry3::identity(); 4],
+                com: Vector2::zeros(),
+                com_velocity: Vector2::zeros(),
+                end_effectors: [None; 4],
+            },
+        }
+    }
+
+    /// Declares the feet standing when the world frame is set up (anchored at `poses`).
+    pub fn set_standing(&mut self, standing: [bool; 2], poses: &[Isometry3<f64>; 4]) {
+        for (slot, foot) in FEET.iter().enumerate() {
+            let e = *foot as usize;
+            self.targets.contacts[e] = standing[slot];
+            self.targets.anchors[e] = poses[e];
+            self.free_targets[e] = (!standing[slot]).then_some(poses[e]);
+        }
+    }
+
+    /// The live contact set and anchors (also used for estimation while holding).
+    pub fn targets(&self) -> &Targets {
+        &self.targets
+    }
+
+    /// World anchors of the feet in contact, for the estimator.
+    pub fn foot_anchors(&self) -> [Option<&Isometry3<f64>>; 2] {
+        FEET.map(|f| {
+            let e = f as usize;
+            self.targets.contacts[e].then_some(&self.targets.anchors[e])
+        })
+    }
+
+    /// The posture reference of the stance being moved towards.
+    pub fn posture(&self) -> Option<&nalgebra::DVector<f64>> {
+        self.sequence
+            .as_ref()
+            .map(|s| &s.stances[self.stance.min(s.stances.len() - 1)].posture)
+    }
+
+    /// Current phase (None when no transition runs).
+    pub fn phase(&self) -> Phase {
+        if self.started {
+            self.current_step().phase
+        } else {
+            Phase::None
+        }
+    }
+
+    /// Index of the stance being moved towards and the stance count.
+    pub fn progress(&self) -> (usize, usize) {
+        (self.stance, self.sequence.as_ref().map_or(0, |s| s.len()))
+    }
+
+    /// Installs a sequence to execute from the next update; returns the previous one.
+    pub fn load(&mut self, sequence: Box<PreparedSequence>) -> Option<Box<PreparedSequence>> {
+        self.started = false;
+        self.stance = 0;
+        self.sequence.replace(sequence)
+    }
+
+    /// Stops executing (the contact set and anchors stay as they are).
+    pub fn stop(&mut self) {
+        self.started = false;
+        self.deadline = f64::INFINITY;
+    }
+
+    /// One tick of the sequence: starts it on the first call after `load`, checks the current
+    /// phase's completion and timeout, advances, and refreshes the targets.
+    pub fn update(&mut self, feedback: &Feedback, dt: f64) -> Progress {
+        if !self.started {
+            self.begin(feedback);
+        } else {
+            self.phase_time += dt;
+            self.com_time += dt;
+        }
+        loop {
+            match self.check_step(feedback) {
+                StepStatus::Running => break,
+                StepStatus::TimedOut => {
+                    return Progress::Fault(FaultCode::Timeout(self.current_step().phase));
+                }
+                StepStatus::Complete => {
+                    self.finish_step(feedback);
+                    if !self.advance(feedback) {
+                        self.refresh_targets();
+                        return Progress::Done;
+                    }
+                }
+            }
+        }
+        self.refresh_targets();
+        Progress::Running
+    }
+
+    fn sequence(&self) -> &PreparedSequence {
+        self.sequence
+            .as_ref()
+            .expect("state machine runs only with a sequence")
+    }
+
+    fn current_step(&self) -> Step {
+        self.plan.steps()[self.step]
+    }
+
+    /// Aligns the sequence's frame with the robot's feet and starts the first transition.
+    fn begin(&mut self, feedback: &Feedback) {
+        self.to_world = self.alignment();
+        self.started = true;
+        self.stance = 0;
+        let com = feedback.com.xy();
+        self.com_motion = PointTrajectory::new(com, com, self.config.min_motion_s);
+        self.com_time = 0.0;
+        self.begin_transition(feedback);
+    }
+
+    /// The planar (x, y, yaw) transform taking the first stance's contact feet onto the feet
+    /// standing now.
+    fn alignment(&self) -> Isometry3<f64> {
+        let first = &self.sequence().stances[0];
+        let mut shared = FEET.map(|f| {
+            let e = f as usize;
+            self.targets.contacts[e] && first.contacts[e]
+        });
+        if !shared.iter().any(|s| *s) {
+            shared = FEET.map(|f| self.targets.contacts[f as usize]);
+        }
+        let world = planar_frame(
+            FEET.iter()
+                .zip(shared)
+                .filter(|(_, s)| *s)
+                .map(|(f, _)| &self.targets.anchors[*f as usize]),
+        );
+        let sequence = planar_frame(
+            FEET.iter()
+                .zip(shared)
+                .filter(|(_, s)| *s)
+                .map(|(f, _)| &first.targets[*f as usize]),
+        );
+        world * sequence.inverse()
+    }
+
+    fn world_target(&self, e: EndEffector) -> Isometry3<f64> {
+        self.to_world * self.sequence().stances[self.stance].targets[e as usize]
+    }
+
+    fn begin_transition(&mut self, feedback: &Feedback) {
+        let next = self.sequence().stances[self.stance].contacts;
+        let is_last = self.stance + 1 == self.sequence().len();
+        for hand in [EndEffector::LeftHand, EndEffector::RightHand] {
+            if !next[hand as usize] {
+                self.targets.contacts[hand as usize] = false;
+            }
+        }
+        self.plan = TransitionPlan::new(self.targets.contacts, next, is_last);
+        self.step = 0;
+        self.enter_step(feedback);
+    }
+
+    /// Moves to the next step or transition; false when the sequence is finished.
+    fn advance(&mut self, feedback: &Feedback) -> bool {
+        self.step += 1;
+        if self.step < self.plan.steps().len() {
+            self.enter_step(feedback);
+            return true;
+        }
+        self.stance += 1;
+        if self.stance == self.sequence().len() {
+            self.stance -= 1;
+            self.started = false;
+            return false;
+        }
+        self.begin_transition(feedback);
+        true
+    }
+
+    fn enter_step(&mut self, feedback: &Feedback) {
+        self.phase_time = 0.0;
+        self.debounce = 0;
+        self.motion_is_via = false;
+        let step = self.current_step();
+        let c = self.config;
+        let timeout = c.phase_timeout_s;
+        let duration = match (step.phase, step.end_effector) {
+            (Phase::ShiftCom | Phase::Settle, excluded) => {
+                let goal = self.support_centre(excluded);
+                self.set_com_support(excluded);
+                let start = feedback.com.xy();
+                let duration = c.min_motion_s.max((goal - start).norm() / c.com_speed);
+                self.com_motion = PointTrajectory::new(start, goal, duration);
+                self.com_time = 0.0;
+                duration
+            }
+            (Phase::Unload, Some(foot)) => {
+                // Straight up from where the foot is estimated to be (not its anchor): pulling it
+                // back to the anchor would drag it along the ground while it still touches.
+                let start = feedback.poses[foot as usize];
+                self.targets.contacts[foot as usize] = false;
+                let goal = raised(&start, c.unload_lift_m);
+                self.motion =
+                    PoseTrajectory::new(start, goal, c.min_motion_s, Profile::MinimumJerk);
+                c.min_motion_s
+            }
+            (Phase::Lift, Some(_)) => {
+                let start = *self.motion.goal();
+                let goal = raised(&start, c.lift_height_m);
+                self.timed_motion(start, goal, Profile::MinimumJerk);
+                self.motion.duration()
+            }
+            (Phase::Swing, Some(foot)) => {
+                let start =
+                    self.free_targets[foot as usize].unwrap_or(feedback.poses[foot as usize]);
+                let target = self.world_target(foot);
+                self.motion_is_via = !self.sequence().stances[self.stance].contacts[foot as usize];
+                let goal = if self.motion_is_via {
+                    target
+                } else {
+                    raised(&target, c.approach_height_m)
+                };
+                self.timed_motion(start, goal, Profile::MinimumJerk);
+                self.motion.duration()
+            }
+            (Phase::Lower, Some(foot)) => {
+                // Straight down from where the approach ended (within tolerance of the planned
+                // contact), so no horizontal correction is still under way at touchdown.
+                let start = feedback.poses[foot as usize];
+                let target = self.world_target(foot);
+                let goal = Isometry3::from_parts(
+                    Translation3::new(
+                        start.translation.x,
+                        start.translation.y,
+                        target.translation.z - c.lower_overshoot_m,
+                    ),
+                    target.rotation,
+                );
+                let distance = (goal.translation.vector - start.translation.vector).norm();
+                let duration = (distance / c.lower_speed).max(1e-3);
+                self.motion = PoseTrajectory::new(start, goal, duration, Profile::Linear);
+                duration
+            }
+            (Phase::Reach, Some(hand)) => {
+                let start = feedback.poses[hand as usize];
+                let goal = self.world_target(hand);
+                self.timed_motion(start, goal, Profile::MinimumJerk);
+                self.motion.duration()
+            }
+            (phase, None) => unreachable!("phase {phase:?} needs an end-effector"),
+            (Phase::None, _) => unreachable!("plans hold no empty phase"),
+        };
+        self.deadline = duration + timeout;
+    }
+
+    /// A motion from `start` to `goal` at the configured swing speeds.
+    fn timed_motion(&mut self, start: Isometry3<f64>, goal: Isometry3<f64>, profile: Profile) {
+        let c = &self.config;
+        let distance = (goal.translation.vector - start.translation.vector).norm();
+        let angle = goal.rotation.angle_to(&start.rotation);
+        let duration = c
+            .min_motion_s
+            .max(distance / c.swing_speed)
+            .max(angle / c.swing_angular_speed);
+        self.motion = PoseTrajectory::new(start, goal, duration, profile);
+    }
+
+    /// Centre of the feet in contact, leaving out `excluded` (the foot about to be released).
+    fn support_centre(&self, excluded: Option<EndEffector>) -> Vector2<f64> {
+        let (sum, count) = FEET
+            .iter()
+            .filter(|f| Some(**f) != excluded && self.targets.contacts[**f as usize])
+            .fold((Vector2::zeros(), 0.0), |(sum, n), f| {
+                (
+                    sum + self.targets.anchors[*f as usize].translation.vector.xy(),
+                    n + 1.0,
+                )
+            });
+        sum / count
+    }
+
+    /// The polygon of the feet in contact except `excluded`.
+    fn set_com_support(&mut self, excluded: Option<EndEffector>) {
+        let mut corners = [[0.0; 2]; 8];
+        let mut count = 0;
+        for foot in FEET {
+            if Some(foot) == excluded || !self.targets.contacts[foot as usize] {
+                continue;
+            }
+            for corner in sole_corners(&self.targets.anchors[foot as usize], &self.sole) {
+                corners[count] = [corner.x, corner.y];
+                count += 1;
+            }
+        }
+        self.com_support.set_hull(&corners[..count]);
+    }
+
+    fn check_step(&mut self, feedback: &Feedback) -> StepStatus {
+        let step = self.current_step();
+        let c = &self.config;
+        let complete = match (step.phase, step.end_effector) {
+            (Phase::ShiftCom | Phase::Settle, _) => {
+                let com = feedback.com.xy();
+                let reached = (com - self.com_motion.goal()).norm() <= c.com_tolerance_m;
+                let stalled_inside = self.com_time >= self.com_motion.duration() + COM_SETTLE_S
+                    && self.com_support.signed_distance([com.x, com.y])
+                        >= c.support_margin_m + c.com_tolerance_m;
+                self.com_time >= self.com_motion.duration() && (reached || stalled_inside)
+            }
+            (Phase::Unload, Some(foot)) => {
+                self.debounced(feedback.normal_forces[foot as usize] < self.release_force)
+            }
+            (Phase::Lower, Some(foot)) => {
+                self.debounced(feedback.normal_forces[foot as usize] > self.touchdown_force)
+            }
+            (Phase::Lift | Phase::Swing | Phase::Reach, Some(e)) => {
+                let goal = self.motion.goal();
+                let pose = &feedback.poses[e as usize];
+                let (position_tolerance, orientation_tolerance) = if self.motion_is_via {
+                    (c.via_position_tolerance_m, c.via_orientation_tolerance_rad)
+                } else if step.phase == Phase::Reach {
+                    (
+                        c.hand_position_tolerance_m,
+                        c.hand_orientation_tolerance_rad,
+                    )
+                } else {
+                    (c.position_tolerance_m, c.orientation_tolerance_rad)
+                };
+                self.phase_time >= self.motion.duration()
+                    && (pose.translation.vector - goal.translation.vector).norm()
+                        <= position_tolerance
+                    && pose.rotation.angle_to(&goal.rotation) <= orientation_tolerance
+            }
+            _ => true,
+        };
+        if complete {
+            StepStatus::Complete
+        } else if self.phase_time > self.deadline {
+            StepStatus::TimedOut
+        } else {
+            StepStatus::Running
+        }
+    }
+
+    /// Counts consecutive ticks with `condition`; true once the debounce count is reached.
+    fn debounced(&mut self, condition: bool) -> bool {
+        self.debounce = if condition { self.debounce + 1 } else { 0 };
+        self.debounce >= self.config.touchdown_debounce_ticks
+    }
+
+    fn finish_step(&mut self, feedback: &Feedback) {
+        let step = self.current_step();
+        if matches!(step.phase, Phase::ShiftCom | Phase::Settle) {
+            // Hold the CoM where the shift ended (it may have stalled short of its goal).
+            let com = feedback.com.xy();
+            self.com_motion = PointTrajectory::new(com, com, self.config.min_motion_s);
+            self.com_time = self.config.min_motion_s;
+            return;
+        }
+        let Some(e) = step.end_effector else {
+            return;
+        };
+        let i = e as usize;
+        match step.phase {
+            Phase::Lower => {
+                // Anchor where the foot landed, at the surface's height: the estimate there
+                // includes the ground compression that confirmed the touchdown, and keeping it
+                // would let the height estimate sink a little with every step.
+                let mut anchor = feedback.poses[i];
+                anchor.translation.z = self.world_target(e).translation.z;
+                self.targets.contacts[i] = true;
+                self.targets.anchors[i] = anchor;
+                self.free_targets[i] = None;
+            }
+            Phase::Reach => {
+                self.targets.contacts[i] = true;
+                self.targets.anchors[i] = *self.motion.goal();
+            }
+            Phase::Lift | Phase::Swing => self.free_targets[i] = Some(*self.motion.goal()),
+            _ => {}
+        }
+    }
+
+    fn refresh_targets(&mut self) {
+        let (com, com_velocity) = self.com_motion.sample(self.com_time);
+        self.targets.com = com;
+        self.targets.com_velocity = com_velocity;
+        let moving = if self.started {
+            let step = self.current_step();
+            match step.phase {
+                Phase::Unload | Phase::Lift | Phase::Swing | Phase::Lower | Phase::Reach => {
+                    step.end_effector
+                }
+                _ => None,
+            }
+        } else {
+            None
+        };
+        for e in EndEffector::ALL {
+            let i = e as usize;
+            self.targets.end_effectors[i] = if Some(e) == moving {
+                let (pose, velocity) = self.motion.sample(self.phase_time);
+                Some(PoseTarget { pose, velocity })
+            } else if self.targets.contacts[i] {
+                (!e.is_foot()).then_some(PoseTarget {
+                    pose: self.targets.anchors[i],
+                    velocity: [0.0; 6],
+                })
+            } else {
+                self.free_targets[i].map(|pose| PoseTarget {
+                    pose,
+                    velocity: [0.0; 6],
+                })
+            };
+        }
+    }
+}
+
+enum StepStatus {
+    Running,
+    Complete,
+    TimedOut,
+}
+
+/// `pose` moved up by `height` along world z.
+fn raised(pose: &Isometry3<f64>, height: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::from(pose.translation.vector + Vector3::z() * height),
+        pose.rotation,
+    )
+}
+
+/// The planar frame (mean x, y and mean yaw) of some poses.
+fn planar_frame<'a>(poses: impl Iterator<Item = &'a Isometry3<f64>>) -> Isometry3<f64> {
+    let (mut x, mut y, mut sin, mut cos, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for pose in poses {
+        let (_, _, yaw) = pose.rotation.euler_angles();
+        x += pose.translation.x;
+        y += pose.translation.y;
+        sin += yaw.sin();
+        cos += yaw.cos();
+        n += 1.0;
+    }
+    if n == 0.0 {
+        return Isometry3::identity();
+    }
+    Isometry3::from_parts(
+        Translation3::new(x / n, y / n, 0.0),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, sin.atan2(cos)),
+    )
+}

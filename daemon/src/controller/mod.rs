@@ -1,0 +1,422 @@
+//! The controller core: a velocity-resolved whole-body QP and the stance state machine.
+//!
+//! It never touches IPC, clocks, files or threads: the runtime, the bench and the tests feed it a
+//! [`Measurement`] and a time step, and it writes a [`Command`]. After [`Controller::new`] a tick
+//! allocates nothing. See `docs/controller.md` for the behaviour and tuning.
+//!
+//! Each executing tick:
+//! 1. checks the measurement (sizes, finite values);
+//! 2. estimates the floating base from the feet in contact (leg odometry, IMU orientation if any);
+//! 3. advances the state machine ([`Phase`]s per transition; contact changes confirmed by FT);
+//! 4. builds the QP (CoM x/y, end-effector, upright and posture tasks; contact, support polygon,
+//!    joint position and velocity constraints) and solves it with the chosen back-end;
+//! 5. writes `q_des = q + q̇·dt` clamped inside the joint limits, `qd_des = q̇`.
+//!
+//! A failed solve, an invalid measurement or a phase timeout holds the last safe command and
+//! enters [`ControllerState::Fault`].
+
+mod assembly;
+mod config;
+mod estimator;
+mod machine;
+mod plan;
+mod sequence;
+mod status;
+mod trajectory;
+
+use std::sync::Arc;
+
+use kinematics::configuration::Configuration;
+use kinematics::kinematics::Kinematics;
+use kinematics::robot::{EndEffector, Robot};
+use nalgebra::{DVector, Isometry3, UnitQuaternion};
+
+pub use config::{ConfigError, ControllerConfig};
+pub use sequence::{PreparedSequence, Refusal};
+pub use status::{ControllerState, ControllerStatus, FaultCode, Phase};
+
+use assembly::QpAssembler;
+use estimator::BaseEstimator;
+use machine::{Feedback, Progress, StateMachine};
+
+use crate::qp::{ClarabelSolver, DenseActiveSetSolver, QpError, QpProblem, QpSolver};
+
+/// Which QP back-end the controller uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SolverKind {
+    /// The allocation-free, warm-started dense active-set solver (the real-time default).
+    #[default]
+    Dense,
+    /// The clarabel interior-point reference (allocates per solve; for comparison).
+    Clarabel,
+}
+
+impl SolverKind {
+    /// Lower-case name (`dense`, `clarabel`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Dense => "dense",
+            Self::Clarabel => "clarabel",
+        }
+    }
+}
+
+/// One tick's input, borrowed from whatever transport delivered it.
+#[derive(Clone, Copy, Debug)]
+pub struct Measurement<'a> {
+    /// Joint angles, model order, `len == model.dof()`.
+    pub q: &'a [f64],
+    /// Joint velocities.
+    pub qd: &'a [f64],
+    /// Force xyz and torque xyz at the FT frames, by `EndEffector` (LF, RF, LH, RH), in
+    /// world-aligned axes at the sensor frame origin: the force the environment exerts on the robot.
+    pub wrenches: &'a [[f64; 6]; 4],
+    /// Base orientation if the adapter has an IMU.
+    pub imu_orientation: Option<UnitQuaternion<f64>>,
+}
+
+/// Whether the actuators should track the command or hold position.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CommandMode {
+    /// Hold `q_des` (velocity zero).
+    Hold,
+    /// Track `q_des` with feed-forward `qd_des`.
+    Track,
+}
+
+/// One tick's output, preallocated by the caller.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Command {
+    /// Desired joint angles (always finite and inside the joint limits).
+    pub q_des: DVector<f64>,
+    /// Desired joint velocities.
+    pub qd_des: DVector<f64>,
+    /// Track or hold.
+    pub mode: CommandMode,
+}
+
+impl Command {
+    /// A zero hold command for `dof` joints.
+    pub fn new(dof: usize) -> Self {
+        Self {
+            q_des: DVector::zeros(dof),
+            qd_des: DVector::zeros(dof),
+            mode: CommandMode::Hold,
+        }
+    }
+}
+
+/// Why a controller could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum ControllerError {
+    /// The configuration is invalid.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+}
+
+/// The controller core; see the module docs.
+pub struct Controller {
+    robot: Arc<Robot>,
+    config: ControllerConfig,
+    solver: Box<dyn QpSolver + Send>,
+    kinematics: Kinematics,
+    configuration: Configuration,
+    estimator: BaseEstimator,
+    machine: StateMachine,
+    assembler: QpAssembler,
+    solution: Vec<f64>,
+    poses: [Isometry3<f64>; 4],
+    hold_q: DVector<f64>,
+    world_ready: bool,
+    status: ControllerStatus,
+}
+
+impl Controller {
+    /// Builds a controller for `robot`; every buffer of the tick is allocated here.
+    pub fn new(
+        robot: Arc<Robot>,
+        config: ControllerConfig,
+        solver: SolverKind,
+    ) -> Result<Controller, ControllerError> {
+        config.validate("controller config")?;
+        let model = &robot.model;
+        let nv = model.nv();
+        let solver: Box<dyn QpSolver + Send> = match solver {
+            SolverKind::Dense => Box::new(DenseActiveSetSolver::new(
+                nv,
+                assembly::MAX_EQUALITY_ROWS,
+                assembly::MAX_INEQUALITY_ROWS,
+            )),
+            SolverKind::Clarabel => Box::new(ClarabelSolver::new()),
+        };
+        let weight = model.total_mass() * kinematic_sim::GRAVITY;
+        Ok(Controller {
+            kinematics: Kinematics::new(model),
+            configuration: robot.standing.clone(),
+            estimator: BaseEstimator::new(robot.standing.base),
+            machine: StateMachine::new(&config, robot.sole, weight),
+            assembler: QpAssembler::new(&robot),
+            solution: vec![0.0; nv],
+            poses: [Isometry3::identity(); 4],
+            hold_q: robot.standing.joints.clone(),
+            world_ready: false,
+            status: ControllerStatus::default(),
+            solver,
+            config,
+            robot,
+        })
+    }
+
+    /// Non-RT: validates a post-processed sequence against the robot and config and prepares it.
+    pub fn prepare(
+        robot: &Robot,
+        config: &ControllerConfig,
+        seq: &stance::PostProcessedSequence,
+    ) -> Result<PreparedSequence, Refusal> {
+        PreparedSequence::new(robot, config, seq)
+    }
+
+    /// RT: begins executing `seq` from Idle, Holding or Done. Returns the previously held
+    /// sequence (drop it off the RT thread); gives `seq` back while executing or in Fault (call
+    /// [`reset`](Self::reset) first).
+    pub fn start(
+        &mut self,
+        seq: Box<PreparedSequence>,
+    ) -> Result<Option<Box<PreparedSequence>>, Box<PreparedSequence>> {
+        match self.status.state {
+            ControllerState::Executing | ControllerState::Fault => Err(seq),
+            _ => {
+                let previous = self.machine.load(seq);
+                self.status.state = ControllerState::Executing;
+                self.status.stance_index = 0;
+                self.status.stance_count = self.machine.progress().1 as u32;
+                Ok(previous)
+            }
+        }
+    }
+
+    /// RT: one control step; see the module docs. Never writes NaN or out-of-limit values.
+    pub fn tick(&mut self, measurement: &Measurement, dt: f64, out: &mut Command) {
+        self.status.ticks += 1;
+        if !self.measurement_valid(measurement, dt) {
+            self.enter_fault(FaultCode::InvalidMeasurement);
+            self.write_hold(out);
+            return;
+        }
+        self.configuration.joints.copy_from_slice(measurement.q);
+        if !self.world_ready {
+            self.initialise_world(measurement);
+        }
+        if !self.estimate(measurement) {
+            self.enter_fault(FaultCode::LostSupport);
+            self.write_hold(out);
+            return;
+        }
+        if self.status.state != ControllerState::Executing {
+            self.write_hold(out);
+            return;
+        }
+        let feedback = Feedback {
+            com: self.kinematics.com(),
+            poses: &self.poses,
+            normal_forces: measurement.wrenches.map(|w| w[2]),
+        };
+        match self.machine.update(&feedback, dt) {
+            Progress::Running => {}
+            Progress::Done => {
+                self.status.state = ControllerState::Done;
+                self.hold_q.copy_from_slice(measurement.q);
+                self.publish_progress();
+                self.write_hold(out);
+                return;
+            }
+            Progress::Fault(code) => {
+                self.enter_fault(code);
+                self.write_hold(out);
+                return;
+            }
+        }
+        self.publish_progress();
+        let posture = self
+            .machine
+            .posture()
+            .expect("executing implies a sequence");
+        self.assembler.assemble(
+            &self.robot,
+            &self.config,
+            &self.kinematics,
+            &self.configuration,
+            self.machine.targets(),
+            posture,
+            dt,
+        );
+        match self
+            .solver
+            .solve(self.assembler.problem(), &mut self.solution)
+        {
+            Ok(info) => {
+                self.status.qp_iterations = info.iterations as u32;
+                self.status.qp_active_constraints = info.active_constraints as u32;
+            }
+            Err(error) => {
+                self.enter_fault(match error {
+                    QpError::Infeasible => FaultCode::QpInfeasible,
+                    _ => FaultCode::QpFailed,
+                });
+                self.write_hold(out);
+                return;
+            }
+        }
+        self.write_track(measurement, dt, out);
+    }
+
+    /// RT: stops executing and holds the current posture (→ Holding).
+    pub fn abort(&mut self) {
+        self.hold();
+    }
+
+    /// RT: holds the current posture (→ Holding), from any state except a fault.
+    pub fn hold(&mut self) {
+        if self.status.state == ControllerState::Fault {
+            return;
+        }
+        self.machine.stop();
+        self.hold_q.copy_from(&self.configuration.joints);
+        self.status.state = ControllerState::Holding;
+        self.status.phase = Phase::None;
+    }
+
+    /// RT: acknowledges a fault (→ Holding the last safe command); no effect otherwise.
+    pub fn reset(&mut self) {
+        if self.status.state == ControllerState::Fault {
+            self.machine.stop();
+            self.status.state = ControllerState::Holding;
+            self.status.phase = Phase::None;
+        }
+    }
+
+    /// The status of the last tick.
+    pub fn status(&self) -> &ControllerStatus {
+        &self.status
+    }
+
+    /// Row capacities (equality, inequality) of the controller's QPs, to size a solver for them.
+    pub fn qp_capacity() -> (usize, usize) {
+        (assembly::MAX_EQUALITY_ROWS, assembly::MAX_INEQUALITY_ROWS)
+    }
+
+    /// The QP of the last executing tick (for export and solver comparison).
+    pub fn last_problem(&self) -> &QpProblem {
+        self.assembler.problem()
+    }
+
+    /// The robot controlled.
+    pub fn robot(&self) -> &Arc<Robot> {
+        &self.robot
+    }
+
+    fn measurement_valid(&self, m: &Measurement, dt: f64) -> bool {
+        let dof = self.robot.model.dof();
+        m.q.len() == dof
+            && m.qd.len() == dof
+            && m.q.iter().chain(m.qd).all(|v| v.is_finite())
+            && m.wrenches.iter().flatten().all(|v| v.is_finite())
+            && m.imu_orientation
+                .is_none_or(|r| r.coords.iter().all(|v| v.is_finite()))
+            && dt.is_finite()
+            && dt > 0.0
+    }
+
+    /// Sets up the world frame on the first valid measurement and anchors the standing feet.
+    fn initialise_world(&mut self, measurement: &Measurement) {
+        let standing = self.estimator.initialise(
+            &self.robot,
+            &mut self.kinematics,
+            &mut self.configuration,
+            measurement.imu_orientation,
+        );
+        self.update_poses();
+        self.machine.set_standing(standing, &self.poses);
+        self.hold_q.copy_from_slice(measurement.q);
+        self.world_ready = true;
+    }
+
+    /// Leg odometry; false if no foot is anchored.
+    fn estimate(&mut self, measurement: &Measurement) -> bool {
+        let weights = [
+            measurement.wrenches[EndEffector::LeftFoot as usize][2],
+            measurement.wrenches[EndEffector::RightFoot as usize][2],
+        ];
+        let ok = self.estimator.update(
+            &self.robot,
+            &mut self.kinematics,
+            &mut self.configuration,
+            self.machine.foot_anchors(),
+            weights,
+            measurement.imu_orientation,
+        );
+        self.update_poses();
+        let com = self.kinematics.com();
+        self.status.com = [com.x, com.y, com.z];
+        self.status.left_foot = pose_array(&self.poses[EndEffector::LeftFoot as usize]);
+        self.status.right_foot = pose_array(&self.poses[EndEffector::RightFoot as usize]);
+        self.status.contacts = self.machine.targets().contacts;
+        ok
+    }
+
+    fn update_poses(&mut self) {
+        for e in EndEffector::ALL {
+            self.poses[e as usize] = self
+                .kinematics
+                .frame_pose(&self.robot.model, self.robot.frame(e));
+        }
+    }
+
+    fn publish_progress(&mut self) {
+        let (stance, count) = self.machine.progress();
+        self.status.stance_index = stance as u32;
+        self.status.stance_count = count as u32;
+        self.status.phase = self.machine.phase();
+        self.status.contacts = self.machine.targets().contacts;
+    }
+
+    fn enter_fault(&mut self, code: FaultCode) {
+        if self.status.state == ControllerState::Fault {
+            return;
+        }
+        self.machine.stop();
+        self.status.state = ControllerState::Fault;
+        self.status.fault = code;
+    }
+
+    /// Holds `hold_q` (the last safe command or the posture at hold time).
+    fn write_hold(&self, out: &mut Command) {
+        out.q_des.copy_from(&self.hold_q);
+        out.qd_des.fill(0.0);
+        out.mode = CommandMode::Hold;
+    }
+
+    /// `q_des = q + q̇·dt` inside the joint limits; non-finite → fault and hold.
+    fn write_track(&mut self, measurement: &Measurement, dt: f64, out: &mut Command) {
+        let limits = self.robot.model.joint_limits();
+        let qd = &self.solution[6..];
+        if qd.iter().any(|v| !v.is_finite()) {
+            self.enter_fault(FaultCode::NonFiniteCommand);
+            self.write_hold(out);
+            return;
+        }
+        for (j, limit) in limits.iter().enumerate() {
+            let q = (measurement.q[j] + qd[j] * dt).clamp(limit.lower, limit.upper);
+            out.q_des[j] = q;
+            out.qd_des[j] = (q - measurement.q[j]) / dt;
+        }
+        out.mode = CommandMode::Track;
+        self.hold_q.copy_from(&out.q_des);
+    }
+}
+
+fn pose_array(pose: &Isometry3<f64>) -> [f64; 7] {
+    let t = pose.translation.vector;
+    let r = pose.rotation.coords;
+    [t.x, t.y, t.z, r.x, r.y, r.z, r.w]
+}

@@ -1,0 +1,130 @@
+//! The phases of one transition `S_i → S_{i+1}`, derived from which contacts are made and broken.
+//!
+//! Contacts are added before any is released, so support never shrinks before the new one is
+//! confirmed: for an added foot `Swing` (to just above the contact) then `Lower`; for an added
+//! hand `Reach`; for a released foot `ShiftCom` (over the remaining support), `Unload`, `Lift`,
+//! `Swing` (to the stance's swing pose). A transition with no foot released re-centres the CoM.
+//! The last transition ends with `Settle`.
+
+use kinematics::robot::EndEffector;
+
+use super::status::Phase;
+
+/// Most steps a transition can have (two feet, two hands, settle).
+const MAX_STEPS: usize = 10;
+
+/// One phase and the end-effector it moves (none for CoM-only phases).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Step {
+    pub phase: Phase,
+    pub end_effector: Option<EndEffector>,
+}
+
+/// The ordered steps of one transition (fixed capacity, built on the real-time path).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TransitionPlan {
+    steps: [Step; MAX_STEPS],
+    len: usize,
+}
+
+impl TransitionPlan {
+    /// The plan from the live contact set `live` to the stance contact flags `next`.
+    pub fn new(live: [bool; 4], next: [bool; 4], is_last: bool) -> Self {
+        let mut plan = Self {
+            steps: [Step {
+                phase: Phase::None,
+                end_effector: None,
+            }; MAX_STEPS],
+            len: 0,
+        };
+        let added = |e: EndEffector| next[e as usize] && !live[e as usize];
+        let released = |e: EndEffector| live[e as usize] && !next[e as usize];
+        for e in EndEffector::ALL {
+            if added(e) && e.is_foot() {
+                plan.push(Phase::Swing, Some(e));
+                plan.push(Phase::Lower, Some(e));
+            } else if added(e) {
+                plan.push(Phase::Reach, Some(e));
+            }
+        }
+        let mut foot_released = false;
+        for e in [EndEffector::LeftFoot, EndEffector::RightFoot] {
+            if released(e) {
+                foot_released = true;
+                plan.push(Phase::ShiftCom, Some(e));
+                plan.push(Phase::Unload, Some(e));
+                plan.push(Phase::Lift, Some(e));
+                plan.push(Phase::Swing, Some(e));
+            }
+        }
+        if !foot_released && !is_last {
+            plan.push(Phase::ShiftCom, None);
+        }
+        if is_last {
+            plan.push(Phase::Settle, None);
+        }
+        plan
+    }
+
+    fn push(&mut self, phase: Phase, end_effector: Option<EndEffector>) {
+        self.steps[self.len] = Step {
+            phase,
+            end_effector,
+        };
+        self.len += 1;
+    }
+
+    /// The steps in order.
+    pub fn steps(&self) -> &[Step] {
+        &self.steps[..self.len]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn phases(plan: &TransitionPlan) -> Vec<Phase> {
+        plan.steps().iter().map(|s| s.phase).collect()
+    }
+
+    #[test]
+    fn double_to_single_support_releases_the_foot_after_shifting_the_com() {
+        let plan = TransitionPlan::new(
+            [true, true, false, false],
+            [true, false, false, false],
+            false,
+        );
+        assert_eq!(
+            phases(&plan),
+            [Phase::ShiftCom, Phase::Unload, Phase::Lift, Phase::Swing]
+        );
+        assert!(
+            plan.steps()
+                .iter()
+                .all(|s| s.end_effector == Some(EndEffector::RightFoot))
+        );
+    }
+
+    #[test]
+    fn contacts_are_added_before_any_is_released() {
+        let plan = TransitionPlan::new(
+            [true, false, false, false],
+            [false, true, true, false],
+            true,
+        );
+        assert_eq!(
+            phases(&plan),
+            [
+                Phase::Swing,
+                Phase::Lower,
+                Phase::Reach,
+                Phase::ShiftCom,
+                Phase::Unload,
+                Phase::Lift,
+                Phase::Swing,
+                Phase::Settle
+            ]
+        );
+    }
+}

@@ -1,0 +1,137 @@
+//! [`PreparedSequence`]: a post-processed stance sequence checked against the robot and the
+//! controller's limits, converted to the controller's storage off the real-time path.
+
+use kinematics::robot::{EndEffector, Robot};
+use nalgebra::{DVector, Isometry3};
+
+use super::config::ControllerConfig;
+
+/// Tolerance on the posture's joint limits (rad): `q_S` from IK sits on a limit at most by round-off.
+const LIMIT_TOLERANCE: f64 = 1e-6;
+
+/// Why a sequence is refused; the message names the stance and field.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("sequence refused: {0}")]
+pub struct Refusal(pub String);
+
+/// One stance as the controller executes it.
+#[derive(Debug, Clone)]
+pub(crate) struct PreparedStance {
+    /// Posture reference `q_S` (model joint order).
+    pub posture: DVector<f64>,
+    /// Contact flags by `EndEffector`.
+    pub contacts: [bool; 4],
+    /// Target poses by `EndEffector`, in the sequence's world frame.
+    pub targets: [Isometry3<f64>; 4],
+}
+
+/// A validated sequence ready for [`super::Controller::start`]; building it may allocate, so it is
+/// done off the real-time path (see [`super::Controller::prepare`]).
+#[derive(Debug, Clone)]
+pub struct PreparedSequence {
+    pub(crate) stances: Vec<PreparedStance>,
+}
+
+impl PreparedSequence {
+    /// Number of stances.
+    pub fn len(&self) -> usize {
+        self.stances.len()
+    }
+
+    /// Always false: an empty sequence is refused.
+    pub fn is_empty(&self) -> bool {
+        self.stances.is_empty()
+    }
+
+    /// Checks `seq` against `robot` and `config` and converts it.
+    ///
+    /// Refused: another robot or joint order, an empty sequence, a non-finite value, a posture
+    /// beyond a joint limit, a stance without foot support, a step between consecutive contacts
+    /// of one foot longer than `config.max_step_m`.
+    pub fn new(
+        robot: &Robot,
+        config: &ControllerConfig,
+        seq: &stance::PostProcessedSequence,
+    ) -> Result<Self, Refusal> {
+        seq.check_robot(robot)
+            .map_err(|e| Refusal(format!("wrong robot: {e}")))?;
+        if seq.is_empty() {
+            return Err(Refusal("the sequence has no stance".to_owned()));
+        }
+        let limits = robot.model.joint_limits();
+        let names = robot.model.joint_names();
+        let mut stances = Vec::with_capacity(seq.len());
+        for i in 0..seq.len() {
+            let posture = seq.posture(i);
+            if posture.len() != limits.len() {
+                return Err(Refusal(format!(
+                    "stance {i}: posture has {} joints, the robot {}",
+                    posture.len(),
+                    limits.len()
+                )));
+            }
+            for (j, (&q, limit)) in posture.iter().zip(limits).enumerate() {
+                if !q.is_finite() {
+                    return Err(Refusal(format!(
+                        "stance {i}: q[{j}] ({}) is not finite",
+                        names[j]
+                    )));
+                }
+                if q < limit.lower - LIMIT_TOLERANCE || q > limit.upper + LIMIT_TOLERANCE {
+                    return Err(Refusal(format!(
+                        "stance {i}: q[{j}] ({}) = {q:.4} is outside its limits [{:.4}, {:.4}]",
+                        names[j], limit.lower, limit.upper
+                    )));
+                }
+            }
+            let contacts = seq.contacts(i);
+            if !contacts[EndEffector::LeftFoot as usize]
+                && !contacts[EndEffector::RightFoot as usize]
+            {
+                return Err(Refusal(format!("stance {i}: no foot in contact")));
+            }
+            let targets = *seq.targets(i);
+            for (e, target) in EndEffector::ALL.iter().zip(&targets) {
+                let finite = target.translation.vector.iter().all(|v| v.is_finite())
+                    && target.rotation.coords.iter().all(|v| v.is_finite());
+                if !finite {
+                    return Err(Refusal(format!(
+                        "stance {i}: target {} is not finite",
+                        e.name()
+                    )));
+                }
+            }
+            stances.push(PreparedStance {
+                posture: DVector::from_column_slice(posture),
+                contacts,
+                targets: targets.map(|t| Isometry3::from_parts(t.translation, t.rotation)),
+            });
+        }
+        check_step_sizes(&stances, config.max_step_m)?;
+        Ok(Self { stances })
+    }
+}
+
+/// Refuses steps (between consecutive contact poses of one foot) longer than `max_step`.
+fn check_step_sizes(stances: &[PreparedStance], max_step: f64) -> Result<(), Refusal> {
+    for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
+        let mut last_contact: Option<(usize, Isometry3<f64>)> = None;
+        for (i, stance) in stances.iter().enumerate() {
+            if !stance.contacts[foot as usize] {
+                continue;
+            }
+            let pose = stance.targets[foot as usize];
+            if let Some((previous, previous_pose)) = last_contact {
+                let step = (pose.translation.vector - previous_pose.translation.vector).norm();
+                if step > max_step {
+                    return Err(Refusal(format!(
+                        "stance {i}: {} steps {step:.3} m from stance {previous}, more than max_step_m = {max_step}",
+                        foot.name()
+                    )));
+                }
+            }
+            last_contact = Some((i, pose));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,161 @@
+//! Plain `Copy` status data the controller publishes every tick (state, phase, fault, estimates).
+
+/// The top-level state of the controller.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ControllerState {
+    /// No sequence yet; holding the posture measured on the first tick.
+    #[default]
+    Idle,
+    /// Holding the current posture (after `hold`/`abort`, or a fault reset).
+    Holding,
+    /// Executing a sequence; see [`ControllerStatus::phase`] and the stance index.
+    Executing,
+    /// The sequence finished; holding the final posture.
+    Done,
+    /// Something went wrong; holding the last safe command. See [`ControllerStatus::fault`].
+    Fault,
+}
+
+impl ControllerState {
+    /// Lower-case name for logs and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Idle => "idle",
+            Self::Holding => "holding",
+            Self::Executing => "executing",
+            Self::Done => "done",
+            Self::Fault => "fault",
+        }
+    }
+}
+
+/// The phase of a transition towards the next stance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Phase {
+    /// Not executing.
+    #[default]
+    None,
+    /// Moving the CoM over the support that remains after the next release.
+    ShiftCom,
+    /// Raising a foot slightly until its FT normal force drops below the release threshold.
+    Unload,
+    /// Lifting the released foot vertically.
+    Lift,
+    /// Moving a foot through the air to its next swing or pre-contact pose.
+    Swing,
+    /// Descending onto the contact pose until FT confirms touchdown (debounced).
+    Lower,
+    /// Moving a hand to its contact pose (hand contacts are confirmed by pose).
+    Reach,
+    /// Centring the CoM in the final support before `Done`.
+    Settle,
+}
+
+impl Phase {
+    /// Lower-case name for logs and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::ShiftCom => "shift_com",
+            Self::Unload => "unload",
+            Self::Lift => "lift",
+            Self::Swing => "swing",
+            Self::Lower => "lower",
+            Self::Reach => "reach",
+            Self::Settle => "settle",
+        }
+    }
+}
+
+/// Why the controller entered [`ControllerState::Fault`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FaultCode {
+    /// No fault.
+    #[default]
+    None,
+    /// The measurement had the wrong size or a NaN/infinite entry.
+    InvalidMeasurement,
+    /// The QP had no feasible point.
+    QpInfeasible,
+    /// The QP solver failed (iterations, numerics, bad input).
+    QpFailed,
+    /// The solution would have produced a non-finite command.
+    NonFiniteCommand,
+    /// No foot in contact to estimate the floating base from.
+    LostSupport,
+    /// A phase did not reach its target within its planned duration plus the timeout.
+    Timeout(Phase),
+}
+
+impl FaultCode {
+    /// A human-readable reason.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::None => "no fault",
+            Self::InvalidMeasurement => "invalid measurement (wrong size or non-finite value)",
+            Self::QpInfeasible => "QP infeasible",
+            Self::QpFailed => "QP solver failed",
+            Self::NonFiniteCommand => "non-finite command",
+            Self::LostSupport => "no foot in contact",
+            Self::Timeout(Phase::ShiftCom) => "timeout: CoM shift did not reach its target",
+            Self::Timeout(Phase::Unload) => {
+                "timeout: foot force did not drop below the release threshold"
+            }
+            Self::Timeout(Phase::Lift) => "timeout: foot lift did not reach its target",
+            Self::Timeout(Phase::Swing) => "timeout: swing did not reach its target",
+            Self::Timeout(Phase::Lower) => "timeout: touchdown never confirmed by force-torque",
+            Self::Timeout(Phase::Reach) => "timeout: hand did not reach its contact",
+            Self::Timeout(Phase::Settle) => "timeout: CoM did not settle",
+            Self::Timeout(Phase::None) => "timeout",
+        }
+    }
+
+    /// A short machine-readable code (`timeout_lower`, `qp_infeasible`, ...).
+    pub fn code(self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::InvalidMeasurement => "invalid_measurement",
+            Self::QpInfeasible => "qp_infeasible",
+            Self::QpFailed => "qp_failed",
+            Self::NonFiniteCommand => "non_finite_command",
+            Self::LostSupport => "lost_support",
+            Self::Timeout(Phase::ShiftCom) => "timeout_shift_com",
+            Self::Timeout(Phase::Unload) => "timeout_unload",
+            Self::Timeout(Phase::Lift) => "timeout_lift",
+            Self::Timeout(Phase::Swing) => "timeout_swing",
+            Self::Timeout(Phase::Lower) => "timeout_lower",
+            Self::Timeout(Phase::Reach) => "timeout_reach",
+            Self::Timeout(Phase::Settle) => "timeout_settle",
+            Self::Timeout(Phase::None) => "timeout",
+        }
+    }
+}
+
+/// Everything a client or log needs about the controller, updated every tick (plain data).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct ControllerStatus {
+    /// Top-level state.
+    pub state: ControllerState,
+    /// Phase within the current transition (`None` unless executing).
+    pub phase: Phase,
+    /// Index of the stance being moved towards.
+    pub stance_index: u32,
+    /// Number of stances in the sequence.
+    pub stance_count: u32,
+    /// Estimated CoM in the world (m).
+    pub com: [f64; 3],
+    /// Estimated left sole pose: translation xyz + quaternion xyzw.
+    pub left_foot: [f64; 7],
+    /// Estimated right sole pose: translation xyz + quaternion xyzw.
+    pub right_foot: [f64; 7],
+    /// Feet and hands in the QP contact set, by `EndEffector` order.
+    pub contacts: [bool; 4],
+    /// The last fault (kept after leaving `Fault` until the next one).
+    pub fault: FaultCode,
+    /// Ticks since construction.
+    pub ticks: u64,
+    /// Iterations of the last QP solve.
+    pub qp_iterations: u32,
+    /// Active inequality/box constraints at the last QP solution.
+    pub qp_active_constraints: u32,
+}

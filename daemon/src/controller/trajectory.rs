@@ -1,0 +1,158 @@
+//! Set-point trajectories for the tasks: smooth (minimum-jerk) or constant-speed interpolation
+//! of a pose or a ground point, sampled with their feed-forward velocity.
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
+
+/// How the interpolation parameter advances with time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Profile {
+    /// s(τ) = 10τ³ − 15τ⁴ + 6τ⁵: zero velocity and acceleration at both ends.
+    MinimumJerk,
+    /// s(τ) = τ: constant speed (the final descent onto a contact).
+    Linear,
+}
+
+impl Profile {
+    /// (s, ds/dt) at time `t` of a motion lasting `duration`.
+    fn sample(self, t: f64, duration: f64) -> (f64, f64) {
+        if t >= duration {
+            return (1.0, 0.0);
+        }
+        let tau = (t / duration).max(0.0);
+        match self {
+            Self::MinimumJerk => {
+                let t2 = tau * tau;
+                let s = t2 * tau * (10.0 - 15.0 * tau + 6.0 * t2);
+                let ds = 30.0 * t2 * (1.0 - 2.0 * tau + t2) / duration;
+                (s, ds)
+            }
+            Self::Linear => (tau, 1.0 / duration),
+        }
+    }
+}
+
+/// A pose interpolated from `start` to `goal`: translation on the straight line, rotation about
+/// one fixed world axis.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PoseTrajectory {
+    start: Isometry3<f64>,
+    goal: Isometry3<f64>,
+    rotation_axis_angle: Vector3<f64>,
+    duration: f64,
+    profile: Profile,
+}
+
+impl PoseTrajectory {
+    /// A motion from `start` to `goal` lasting `duration` (> 0).
+    pub fn new(
+        start: Isometry3<f64>,
+        goal: Isometry3<f64>,
+        duration: f64,
+        profile: Profile,
+    ) -> Self {
+        Self {
+            start,
+            goal,
+            rotation_axis_angle: (goal.rotation * start.rotation.inverse()).scaled_axis(),
+            duration,
+            profile,
+        }
+    }
+
+    /// A motion that stays at `pose`.
+    pub fn hold(pose: Isometry3<f64>) -> Self {
+        Self::new(pose, pose, 1.0, Profile::Linear)
+    }
+
+    /// The final pose.
+    pub fn goal(&self) -> &Isometry3<f64> {
+        &self.goal
+    }
+
+    /// Planned duration (s).
+    pub fn duration(&self) -> f64 {
+        self.duration
+    }
+
+    /// Pose and world velocity (linear xyz, angular xyz) at time `t`.
+    pub fn sample(&self, t: f64) -> (Isometry3<f64>, [f64; 6]) {
+        let (s, ds) = self.profile.sample(t, self.duration);
+        let delta = self.goal.translation.vector - self.start.translation.vector;
+        let translation = self.start.translation.vector + delta * s;
+        let rotation =
+            UnitQuaternion::from_scaled_axis(self.rotation_axis_angle * s) * self.start.rotation;
+        let v = delta * ds;
+        let w = self.rotation_axis_angle * ds;
+        (
+            Isometry3::from_parts(Translation3::from(translation), rotation),
+            [v.x, v.y, v.z, w.x, w.y, w.z],
+        )
+    }
+}
+
+/// A ground-plane point (the CoM x/y target) interpolated with a minimum-jerk profile.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PointTrajectory {
+    start: Vector2<f64>,
+    goal: Vector2<f64>,
+    duration: f64,
+}
+
+impl PointTrajectory {
+    /// A minimum-jerk motion from `start` to `goal` lasting `duration` (> 0).
+    pub fn new(start: Vector2<f64>, goal: Vector2<f64>, duration: f64) -> Self {
+        Self {
+            start,
+            goal,
+            duration,
+        }
+    }
+
+    /// The final point.
+    pub fn goal(&self) -> Vector2<f64> {
+        self.goal
+    }
+
+    /// Planned duration (s).
+    pub fn duration(&self) -> f64 {
+        self.duration
+    }
+
+    /// Point and velocity at time `t`.
+    pub fn sample(&self, t: f64) -> (Vector2<f64>, Vector2<f64>) {
+        let (s, ds) = Profile::MinimumJerk.sample(t, self.duration);
+        let delta = self.goal - self.start;
+        (self.start + delta * s, delta * ds)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn minimum_jerk_starts_and_ends_at_rest_and_velocity_matches_finite_difference() {
+        let start = Isometry3::translation(0.0, 0.0, 0.0);
+        let goal = Isometry3::from_parts(
+            Translation3::new(0.3, -0.1, 0.05),
+            UnitQuaternion::from_euler_angles(0.0, 0.1, 0.4),
+        );
+        let trajectory = PoseTrajectory::new(start, goal, 1.5, Profile::MinimumJerk);
+        let (p0, v0) = trajectory.sample(0.0);
+        let (p1, v1) = trajectory.sample(2.0);
+        assert!((p0.translation.vector - start.translation.vector).norm() < 1e-12);
+        assert!((p1.translation.vector - goal.translation.vector).norm() < 1e-12);
+        assert!(p1.rotation.angle_to(&goal.rotation) < 1e-12);
+        assert!(v0.iter().chain(&v1).all(|v| v.abs() < 1e-12));
+        let (t, h) = (0.6, 1e-6);
+        let (a, _) = trajectory.sample(t - h);
+        let (b, _) = trajectory.sample(t + h);
+        let (_, v) = trajectory.sample(t);
+        let fd = (b.translation.vector - a.translation.vector) / (2.0 * h);
+        let fd_w = (b.rotation * a.rotation.inverse()).scaled_axis() / (2.0 * h);
+        for k in 0..3 {
+            assert!((fd[k] - v[k]).abs() < 1e-6, "linear {k}");
+            assert!((fd_w[k] - v[3 + k]).abs() < 1e-6, "angular {k}");
+        }
+    }
+}

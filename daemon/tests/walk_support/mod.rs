@@ -1,0 +1,211 @@
+//! Shared helpers of the walk and state-machine tests: robots from the vendored configs, a
+//! synthetic step-to walking sequence, and per-tick safety checks.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use daemon::bench::TickObservation;
+use daemon::controller::{Command, Controller, ControllerConfig, Measurement, SolverKind};
+use kinematic_sim::KinematicSim;
+use kinematics::kinematics::Kinematics;
+use kinematics::robot::{EndEffector, Robot};
+use nalgebra::{Isometry3, Translation3};
+use stance::{Environment, PostProcessedSequence, Stance};
+
+/// Path of `configs/<name>.toml`.
+pub fn config_path(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../configs")
+        .join(format!("{name}.toml"))
+}
+
+/// The vendored robot `name`.
+pub fn robot(name: &str) -> Arc<Robot> {
+    Arc::new(Robot::load(&config_path(name), None).expect("vendored robot loads"))
+}
+
+/// The `[controller]` section of `name`'s config.
+pub fn controller_config(name: &str) -> ControllerConfig {
+    ControllerConfig::from_config_file(&config_path(name)).expect("controller config parses")
+}
+
+/// A step-to walk from the standing posture: the right foot, then the left, each moves
+/// `step` metres forward per step, `steps` steps in all, the swing foot passing 5 cm above
+/// the ground halfway. Postures are the standing posture. With `hand`, the left hand first
+/// takes a contact 3 cm in front of where it hangs and keeps it to the end.
+pub fn synthetic_walk(robot: &Robot, steps: usize, step: f64, hand: bool) -> PostProcessedSequence {
+    let mut kinematics = Kinematics::new(&robot.model);
+    kinematics.update(&robot.model, &robot.standing);
+    let mut poses = EndEffector::ALL.map(|e| kinematics.frame_pose(&robot.model, robot.frame(e)));
+    let posture: Vec<f64> = robot.standing.joints.iter().copied().collect();
+    let stance = |contacts: [bool; 4]| Stance {
+        q: posture.clone(),
+        contacts,
+        translation: nalgebra::Vector3::zeros(),
+        root_orientation: nalgebra::UnitQuaternion::identity(),
+    };
+    let mut stances = vec![stance([true, true, false, false])];
+    let mut targets = vec![poses];
+    let mut base_contacts = [true, true, false, false];
+    if hand {
+        let left_hand = EndEffector::LeftHand as usize;
+        poses[left_hand].translation.vector.x += 0.03;
+        base_contacts[left_hand] = true;
+        stances.push(stance(base_contacts));
+        targets.push(poses);
+    }
+    for k in 0..steps {
+        let foot = if k % 2 == 0 {
+            EndEffector::RightFoot
+        } else {
+            EndEffector::LeftFoot
+        };
+        let from = poses[foot as usize];
+        let to = Isometry3::from_parts(
+            Translation3::from(from.translation.vector + nalgebra::Vector3::x() * step),
+            from.rotation,
+        );
+        let mut swing = poses;
+        swing[foot as usize] = Isometry3::from_parts(
+            Translation3::from(
+                (from.translation.vector + to.translation.vector) / 2.0
+                    + nalgebra::Vector3::z() * 0.05,
+            ),
+            from.rotation,
+        );
+        let mut single = base_contacts;
+        single[foot as usize] = false;
+        stances.push(stance(single));
+        targets.push(swing);
+        poses[foot as usize] = to;
+        stances.push(stance(base_contacts));
+        targets.push(poses);
+    }
+    PostProcessedSequence::new(
+        robot.name.clone(),
+        robot.model.joint_names().to_vec(),
+        Environment::default(),
+        stances,
+        targets,
+    )
+    .expect("synthetic sequence is valid")
+}
+
+/// Per-tick safety: stability margin ≥ 0, slip < 1 mm, no joint limit violation, finite command.
+pub fn check_tick(o: &TickObservation) {
+    let s = &o.sim.safety;
+    assert!(
+        s.stability_margin >= 0.0,
+        "tick {}: stability margin {} < 0 (phase {:?}, stance {})",
+        o.tick,
+        s.stability_margin,
+        o.status.phase,
+        o.status.stance_index
+    );
+    assert!(
+        s.contact_slip < 1e-3,
+        "tick {}: contact slip {} m (phase {:?}, stance {})",
+        o.tick,
+        s.contact_slip,
+        o.status.phase,
+        o.status.stance_index
+    );
+    assert_eq!(
+        s.limit_violations, 0,
+        "tick {}: joint limit violated",
+        o.tick
+    );
+    assert!(
+        o.command
+            .q_des
+            .iter()
+            .chain(o.command.qd_des.iter())
+            .all(|v| v.is_finite()),
+        "tick {}: non-finite command",
+        o.tick
+    );
+}
+
+/// A controller and the kinematic simulator in closed loop, stepped one tick at a time so tests
+/// can tamper with the measurement.
+pub struct Harness {
+    pub robot: Arc<Robot>,
+    pub controller: Controller,
+    pub sim: KinematicSim,
+    pub command: Command,
+    pub dt: f64,
+}
+
+impl Harness {
+    /// A standing robot `name` with the dense solver at `rate_hz`.
+    pub fn new(name: &str, rate_hz: f64) -> Self {
+        let robot = robot(name);
+        let controller =
+            Controller::new(robot.clone(), controller_config(name), SolverKind::Dense).unwrap();
+        let sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
+        let command = Command::new(robot.model.dof());
+        Self {
+            robot,
+            controller,
+            sim,
+            command,
+            dt: 1.0 / rate_hz,
+        }
+    }
+
+    /// Prepares and starts `sequence`.
+    pub fn start(&mut self, sequence: &PostProcessedSequence) {
+        let config = controller_config(&self.robot.name);
+        let prepared = Controller::prepare(&self.robot, &config, sequence).unwrap();
+        assert!(self.controller.start(Box::new(prepared)).is_ok());
+    }
+
+    /// One tick: the measurement's wrenches pass through `tamper`, then the simulator applies
+    /// the command.
+    pub fn tick_with(&mut self, tamper: impl FnOnce(&mut [[f64; 6]; 4])) {
+        let m = self.sim.measurement();
+        let mut wrenches = m.wrenches;
+        tamper(&mut wrenches);
+        let measurement = Measurement {
+            q: m.q.as_slice(),
+            qd: m.qd.as_slice(),
+            wrenches: &wrenches,
+            imu_orientation: Some(m.base_orientation),
+        };
+        self.controller
+            .tick(&measurement, self.dt, &mut self.command);
+        self.sim
+            .step(
+                self.command.q_des.as_slice(),
+                self.command.qd_des.as_slice(),
+                self.dt,
+            )
+            .unwrap();
+    }
+
+    /// One untampered tick.
+    pub fn tick(&mut self) {
+        self.tick_with(|_| {});
+    }
+
+    /// The command is finite and inside the joint limits; the simulator is safe.
+    pub fn assert_safe(&self) {
+        let limits = self.robot.model.joint_limits();
+        for (j, (q, limit)) in self.command.q_des.iter().zip(limits).enumerate() {
+            assert!(
+                q.is_finite() && *q >= limit.lower && *q <= limit.upper,
+                "joint {j}: q_des {q}"
+            );
+        }
+        assert!(self.command.qd_des.iter().all(|v| v.is_finite()));
+        let s = &self.sim.measurement().safety;
+        assert!(
+            s.stability_margin >= 0.0,
+            "stability margin {}",
+            s.stability_margin
+        );
+        assert!(s.contact_slip < 1e-3, "slip {}", s.contact_slip);
+        assert_eq!(s.limit_violations, 0);
+    }
+}

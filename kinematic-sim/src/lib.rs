@@ -1,0 +1,469 @@
+//! A deterministic kinematic simulator shared by `walk-sim --physics kinematic` and `walkd bench`.
+//!
+//! The model is quasi-static and exact where a rigid-body simulator is not:
+//! - **Joints** follow the commanded positions ideally (a perfect position servo); a command beyond
+//!   a joint limit stops at the limit and is counted as a violation.
+//! - **Floating base**: feet in contact are anchored at the world pose where they touched down.
+//!   Each step the base pose is recomputed from the anchored feet: a blend of the per-foot
+//!   solutions weighted by each foot's lever-rule share of the weight, faded out as a foot is
+//!   lifted towards release. A foot in contact therefore stays where it is up to the
+//!   inconsistency of the command, which is reported as slip.
+//! - **Contacts** are derived from kinematics: a free foot touches down when its lowest sole corner
+//!   reaches the ground; an anchored foot is released when lifted more than a tolerance above its
+//!   anchor. Hands carry no load (the ground is the only support surface modelled).
+//! - **Force-torque readings** come from static equilibrium: the weight `m·g` is split between the
+//!   feet in contact by the lever rule on the CoM ground projection, plus a stiff ground
+//!   compliance that moves load onto a foot pressed into the ground; the wrench is expressed at
+//!   each FT frame origin in world-aligned axes (the force the ground exerts on the robot).
+//! - **Safety metrics**: stability margin (signed distance of the CoM ground projection to the
+//!   support polygon; negative = fall), contact slip, penetration, joint limit violations.
+
+pub mod support;
+
+use std::sync::Arc;
+
+use kinematics::configuration::Configuration;
+use kinematics::kinematics::Kinematics;
+use kinematics::robot::{EndEffector, Robot};
+use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
+use support::{SupportPolygon, sole_corners};
+
+/// Standard gravity used for the synthetic force readings (m/s²).
+pub const GRAVITY: f64 = 9.81;
+
+const FEET: [EndEffector; 2] = [EndEffector::LeftFoot, EndEffector::RightFoot];
+
+/// Tunable contact model; the defaults suit the vendored humanoids.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimOptions {
+    /// Height of the ground plane (m).
+    pub ground_height: f64,
+    /// A free foot touches down when its lowest sole corner is this close to the ground (m).
+    pub touchdown_tolerance: f64,
+    /// An anchored foot is released once lifted this far above its anchor (m).
+    pub release_tolerance: f64,
+    /// Ground stiffness that shifts load onto a foot pressed into the ground (N/m).
+    pub ground_stiffness: f64,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        Self {
+            ground_height: 0.0,
+            touchdown_tolerance: 1e-4,
+            release_tolerance: 5e-4,
+            ground_stiffness: 2e6,
+        }
+    }
+}
+
+/// Errors of the simulator API (bad commands or initial states), naming what is wrong.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum SimError {
+    /// The initial configuration does not stand: no foot touches the ground.
+    #[error(
+        "initial configuration: no foot sole touches the ground (lowest sole corner {lowest_m:.4} m above it)"
+    )]
+    NotStanding {
+        /// Height of the lowest sole corner above the ground.
+        lowest_m: f64,
+    },
+    /// A command vector has the wrong length.
+    #[error("command `{field}` has {actual} entries, the model has {expected} joints")]
+    CommandLength {
+        /// `q_des` or `qd_des`.
+        field: &'static str,
+        /// The model's joint count.
+        expected: usize,
+        /// The length given.
+        actual: usize,
+    },
+    /// A command entry is NaN or infinite.
+    #[error("command `{field}` joint {index} ({joint}) is not finite")]
+    NonFiniteCommand {
+        /// `q_des` or `qd_des`.
+        field: &'static str,
+        /// Joint index in model order.
+        index: usize,
+        /// Joint name.
+        joint: String,
+    },
+    /// The time step is not positive and finite.
+    #[error("time step {0} s is not positive and finite")]
+    BadTimeStep(f64),
+}
+
+/// Safety metrics of the current state; the simulator also keeps their worst values.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SafetyMetrics {
+    /// Signed distance of the CoM ground projection to the support polygon (m, < 0 = falling).
+    pub stability_margin: f64,
+    /// Largest horizontal displacement of a foot in contact from its touchdown pose (m).
+    pub contact_slip: f64,
+    /// Deepest sole corner below the ground (m, 0 when none is below).
+    pub penetration: f64,
+    /// Number of joints whose command was beyond a limit this step.
+    pub limit_violations: usize,
+}
+
+/// Worst values over the whole run, for pass/fail checks and reports.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SafetySummary {
+    /// Smallest stability margin seen (m).
+    pub min_stability_margin: f64,
+    /// Largest contact slip seen (m).
+    pub max_contact_slip: f64,
+    /// Deepest penetration seen (m).
+    pub max_penetration: f64,
+    /// Total joint-limit violations (joint × step).
+    pub joint_limit_violations: u64,
+    /// Whether the CoM ever left the support polygon.
+    pub fell: bool,
+    /// Number of states evaluated: the initial state and one per step.
+    pub steps: u64,
+}
+
+impl Default for SafetySummary {
+    fn default() -> Self {
+        Self {
+            min_stability_margin: f64::INFINITY,
+            max_contact_slip: 0.0,
+            max_penetration: 0.0,
+            joint_limit_violations: 0,
+            fell: false,
+            steps: 0,
+        }
+    }
+}
+
+/// What sensors would report, plus ground truth the controller never sees.
+#[derive(Clone, Debug)]
+pub struct SimMeasurement {
+    /// Joint angles (model order).
+    pub q: DVector<f64>,
+    /// Joint velocities over the last step.
+    pub qd: DVector<f64>,
+    /// Force (xyz) and torque (xyz) at each FT frame, world-aligned axes, ordered by
+    /// [`EndEffector`] (hands read zero: no hand support is modelled).
+    pub wrenches: [[f64; 6]; 4],
+    /// The base orientation (an ideal IMU).
+    pub base_orientation: UnitQuaternion<f64>,
+    /// Ground truth: base pose in the world.
+    pub base: Isometry3<f64>,
+    /// Ground truth: centre of mass in the world.
+    pub com: Vector3<f64>,
+    /// Ground truth: which end-effectors are in contact, by [`EndEffector`].
+    pub contacts: [bool; 4],
+    /// Safety metrics of this state.
+    pub safety: SafetyMetrics,
+}
+
+/// The simulator: holds the robot state, the contact anchors and the metrics.
+pub struct KinematicSim {
+    robot: Arc<Robot>,
+    options: SimOptions,
+    configuration: Configuration,
+    kinematics: Kinematics,
+    anchors: [Option<Isometry3<f64>>; 2],
+    measurement: SimMeasurement,
+    summary: SafetySummary,
+    corners: [[f64; 2]; 8],
+}
+
+impl KinematicSim {
+    /// Starts a simulation from `initial` with default options (see [`KinematicSim::with_options`]).
+    pub fn new(robot: Arc<Robot>, initial: Configuration) -> Result<Self, SimError> {
+        Self::with_options(robot, initial, SimOptions::default())
+    }
+
+    /// Starts a simulation from `initial`; feet whose soles touch the ground are anchored there.
+    pub fn with_options(
+        robot: Arc<Robot>,
+        initial: Configuration,
+        options: SimOptions,
+    ) -> Result<Self, SimError> {
+        let mut kinematics = Kinematics::new(&robot.model);
+        kinematics.update(&robot.model, &initial);
+        let dof = robot.model.dof();
+        let measurement = SimMeasurement {
+            q: initial.joints.clone(),
+            qd: DVector::zeros(dof),
+            wrenches: [[0.0; 6]; 4],
+            base_orientation: initial.base.rotation,
+            base: initial.base,
+            com: kinematics.com(),
+            contacts: [false; 4],
+            safety: SafetyMetrics::default(),
+        };
+        let mut sim = Self {
+            robot,
+            options,
+            configuration: initial,
+            kinematics,
+            anchors: [None, None],
+            measurement,
+            summary: SafetySummary::default(),
+            corners: [[0.0; 2]; 8],
+        };
+        let mut lowest = f64::INFINITY;
+        for (slot, foot) in FEET.iter().enumerate() {
+            let height = sim.lowest_corner_height(*foot);
+            lowest = lowest.min(height);
+            if height <= options.touchdown_tolerance {
+                sim.anchors[slot] = Some(sim.pose(*foot));
+            }
+        }
+        if sim.anchors.iter().all(Option::is_none) {
+            return Err(SimError::NotStanding { lowest_m: lowest });
+        }
+        sim.finish_step(0);
+        Ok(sim)
+    }
+
+    /// The robot being simulated.
+    pub fn robot(&self) -> &Arc<Robot> {
+        &self.robot
+    }
+
+    /// The current sensor readings, ground truth and safety metrics.
+    pub fn measurement(&self) -> &SimMeasurement {
+        &self.measurement
+    }
+
+    /// Worst safety values since the start.
+    pub fn summary(&self) -> &SafetySummary {
+        &self.summary
+    }
+
+    /// The full configuration (ground truth base and joints).
+    pub fn configuration(&self) -> &Configuration {
+        &self.configuration
+    }
+
+    /// Advances by `dt`: joints move to `q_des` (ideal servo, stopped at the limits), the base
+    /// follows the feet in contact, contacts, forces and metrics are updated. `qd_des` is checked
+    /// but not needed by the ideal servo.
+    pub fn step(&mut self, q_des: &[f64], qd_des: &[f64], dt: f64) -> Result<(), SimError> {
+        self.check_command("q_des", q_des)?;
+        self.check_command("qd_des", qd_des)?;
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(SimError::BadTimeStep(dt));
+        }
+        let mut violations = 0;
+        let limits = self.robot.model.joint_limits();
+        for (j, (&target, limit)) in q_des.iter().zip(limits).enumerate() {
+            let q = target.clamp(limit.lower, limit.upper);
+            if q != target {
+                violations += 1;
+            }
+            self.measurement.qd[j] = (q - self.configuration.joints[j]) / dt;
+            self.configuration.joints[j] = q;
+        }
+        self.place_base();
+        self.update_contacts();
+        self.finish_step(violations);
+        Ok(())
+    }
+
+    fn check_command(&self, field: &'static str, values: &[f64]) -> Result<(), SimError> {
+        let expected = self.robot.model.dof();
+        if values.len() != expected {
+            return Err(SimError::CommandLength {
+                field,
+                expected,
+                actual: values.len(),
+            });
+        }
+        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+            return Err(SimError::NonFiniteCommand {
+                field,
+                index,
+                joint: self.robot.model.joint_names()[index].clone(),
+            });
+        }
+        Ok(())
+    }
+
+    fn pose(&self, e: EndEffector) -> Isometry3<f64> {
+        self.kinematics
+            .frame_pose(&self.robot.model, self.robot.frame(e))
+    }
+
+    fn lowest_corner_height(&self, foot: EndEffector) -> f64 {
+        sole_corners(&self.pose(foot), &self.robot.sole)
+            .iter()
+            .map(|c| c.z)
+            .fold(f64::INFINITY, f64::min)
+            - self.options.ground_height
+    }
+
+    /// Lever-rule share of the weight carried by each anchored foot (sums to 1 when any is anchored).
+    fn lever_shares(&self, com: &Vector3<f64>) -> [f64; 2] {
+        match self.anchors {
+            [Some(_), None] => [1.0, 0.0],
+            [None, Some(_)] => [0.0, 1.0],
+            [Some(left), Some(right)] => {
+                let (a, b) = (left.translation.vector, right.translation.vector);
+                let ab = (b - a).xy();
+                let t = ((com.xy() - a.xy()).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+                [1.0 - t, t]
+            }
+            [None, None] => [0.0, 0.0],
+        }
+    }
+
+    /// Recomputes the base so the anchored feet stay put (blended by load share).
+    fn place_base(&mut self) {
+        // FK with the previous base gives every foot's pose relative to the base.
+        self.kinematics
+            .update(&self.robot.model, &self.configuration);
+        let base = self.configuration.base;
+        // Each foot holds the base in proportion to its lever-rule share of the weight, faded
+        // out as the foot is lifted towards release: the foot the CoM stands over stays put, a
+        // foot pressed into the ground beside it only penetrates, and a foot being unloaded
+        // stops dragging the base (and so the other foot) before it leaves the ground.
+        let mut shares = self.lever_shares(&self.kinematics.com());
+        for (slot, foot) in FEET.iter().enumerate() {
+            if let Some(anchor) = self.anchors[slot] {
+                let lift = self.pose(*foot).translation.z - anchor.translation.z;
+                shares[slot] *= (1.0 - lift / self.options.release_tolerance).clamp(0.0, 1.0);
+            }
+        }
+        let mut blended: Option<(Isometry3<f64>, f64)> = None;
+        for (slot, foot) in FEET.iter().enumerate() {
+            let Some(anchor) = self.anchors[slot] else {
+                continue;
+            };
+            let foot_in_base = base.inverse() * self.pose(*foot);
+            let candidate = anchor * foot_in_base.inverse();
+            blended = Some(match blended {
+                None => (candidate, shares[slot]),
+                Some((previous, weight)) => {
+                    let total = weight + shares[slot];
+                    let t = if total > 0.0 {
+                        shares[slot] / total
+                    } else {
+                        0.5
+                    };
+                    let translation = previous
+                        .translation
+                        .vector
+                        .lerp(&candidate.translation.vector, t);
+                    let rotation = previous.rotation.nlerp(&candidate.rotation, t);
+                    (
+                        Isometry3::from_parts(Translation3::from(translation), rotation),
+                        total,
+                    )
+                }
+            });
+        }
+        if let Some((mut pose, _)) = blended {
+            // Composing with inverses assumes unit quaternions; without renormalising, a norm
+            // error doubles every step.
+            pose.rotation.renormalize();
+            self.configuration.base = pose;
+        }
+        self.kinematics
+            .update(&self.robot.model, &self.configuration);
+    }
+
+    /// Releases lifted feet and anchors feet that reached the ground.
+    fn update_contacts(&mut self) {
+        for (slot, foot) in FEET.iter().enumerate() {
+            match self.anchors[slot] {
+                Some(anchor) => {
+                    let other_anchored = self.anchors[1 - slot].is_some();
+                    let lift = self.pose(*foot).translation.z - anchor.translation.z;
+                    if other_anchored && lift > self.options.release_tolerance {
+                        self.anchors[slot] = None;
+                    }
+                }
+                None => {
+                    if self.lowest_corner_height(*foot) <= self.options.touchdown_tolerance {
+                        self.anchors[slot] = Some(self.pose(*foot));
+                    }
+                }
+            }
+        }
+    }
+
+    /// Forces, metrics and the measurement record of the new state.
+    fn finish_step(&mut self, limit_violations: usize) {
+        let com = self.kinematics.com();
+        let weight = self.robot.model.total_mass() * GRAVITY;
+        let shares = self.lever_shares(&com);
+        let mut loads = [0.0; 2];
+        let mut slip: f64 = 0.0;
+        let mut corner_count = 0;
+        for (slot, foot) in FEET.iter().enumerate() {
+            let Some(anchor) = self.anchors[slot] else {
+                continue;
+            };
+            let pose = self.pose(*foot);
+            let offset = pose.translation.vector - anchor.translation.vector;
+            slip = slip.max(offset.xy().norm());
+            // Pressing into the ground adds load, lifting off removes it (never below zero).
+            let compression = -offset.z;
+            loads[slot] =
+                (shares[slot] * weight + self.options.ground_stiffness * compression).max(0.0);
+            for corner in sole_corners(&pose, &self.robot.sole) {
+                self.corners[corner_count] = [corner.x, corner.y];
+                corner_count += 1;
+            }
+        }
+        let total: f64 = loads.iter().sum();
+        // Centres of pressure: each sole centre shifted by one common offset chosen so the
+        // resultant acts below the CoM (moment equilibrium about the CoM's vertical).
+        let mut loaded_centre = Vector3::zeros();
+        for (slot, foot) in FEET.iter().enumerate() {
+            if total > 0.0 && self.anchors[slot].is_some() {
+                loaded_centre += loads[slot] / total * self.pose(*foot).translation.vector;
+            }
+        }
+        let cop_offset = Vector3::new(com.x - loaded_centre.x, com.y - loaded_centre.y, 0.0);
+        let mut wrenches = [[0.0; 6]; 4];
+        for (slot, foot) in FEET.iter().enumerate() {
+            if self.anchors[slot].is_none() || total <= 0.0 {
+                continue;
+            }
+            let force = Vector3::new(0.0, 0.0, loads[slot] / total * weight);
+            let cop = self.pose(*foot).translation.vector + cop_offset;
+            let sensor = self
+                .kinematics
+                .frame_pose(&self.robot.model, self.robot.ft_sensors[slot]);
+            let torque = (cop - sensor.translation.vector).cross(&force);
+            wrenches[*foot as usize] = [force.x, force.y, force.z, torque.x, torque.y, torque.z];
+        }
+        let polygon = SupportPolygon::from_points(&self.corners[..corner_count]);
+        let penetration = FEET
+            .iter()
+            .map(|foot| (-self.lowest_corner_height(*foot)).max(0.0))
+            .fold(0.0, f64::max);
+        let safety = SafetyMetrics {
+            stability_margin: polygon.signed_distance([com.x, com.y]),
+            contact_slip: slip,
+            penetration,
+            limit_violations,
+        };
+        let m = &mut self.measurement;
+        m.q.copy_from(&self.configuration.joints);
+        m.wrenches = wrenches;
+        m.base_orientation = self.configuration.base.rotation;
+        m.base = self.configuration.base;
+        m.com = com;
+        m.contacts = [
+            self.anchors[0].is_some(),
+            self.anchors[1].is_some(),
+            false,
+            false,
+        ];
+        m.safety = safety;
+        let s = &mut self.summary;
+        s.min_stability_margin = s.min_stability_margin.min(safety.stability_margin);
+        s.max_contact_slip = s.max_contact_slip.max(safety.contact_slip);
+        s.max_penetration = s.max_penetration.max(safety.penetration);
+        s.joint_limit_violations += limit_violations as u64;
+        s.fell |= safety.stability_margin < 0.0;
+        s.steps += 1;
+    }
+}

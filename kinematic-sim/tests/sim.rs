@@ -1,0 +1,187 @@
+//! Behaviour of the kinematic simulator on the vendored robots.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use kinematic_sim::{GRAVITY, KinematicSim, SimError};
+use kinematics::kinematics::Kinematics;
+use kinematics::robot::{EndEffector, Robot};
+
+fn robot(name: &str) -> Arc<Robot> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../configs/{name}.toml"));
+    Arc::new(Robot::load(&path, None).expect("vendored robot loads"))
+}
+
+fn leg_joint(robot: &Robot, prefix_left: bool, contains: &str) -> usize {
+    let legs = &robot.joint_groups.legs;
+    let half = legs.len() / 2;
+    let side = if prefix_left == (robot.name == "armar4") {
+        &legs[..half]
+    } else {
+        &legs[half..]
+    };
+    *side
+        .iter()
+        .find(|&&j| {
+            robot.model.joint_names()[j]
+                .to_lowercase()
+                .contains(contains)
+        })
+        .expect("leg joint exists")
+}
+
+#[test]
+fn standing_robot_is_supported_by_both_feet_with_its_weight() {
+    for name in ["jvrc1", "armar4"] {
+        let robot = robot(name);
+        let sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
+        let m = sim.measurement();
+        assert_eq!(m.contacts, [true, true, false, false], "{name}");
+        let total: f64 = m.wrenches.iter().map(|w| w[2]).sum();
+        let weight = robot.model.total_mass() * GRAVITY;
+        assert!(
+            (total - weight).abs() < 1e-6 * weight,
+            "{name}: {total} vs {weight}"
+        );
+        assert!(m.safety.stability_margin > 0.0, "{name}");
+        assert_eq!(m.safety.contact_slip, 0.0);
+        // Moment balance: the resultant of the ground forces acts below the CoM.
+        let mut kinematics = Kinematics::new(&robot.model);
+        kinematics.update(&robot.model, sim.configuration());
+        let mut moment_x = 0.0;
+        for (slot, foot) in [EndEffector::LeftFoot, EndEffector::RightFoot]
+            .iter()
+            .enumerate()
+        {
+            let w = m.wrenches[*foot as usize];
+            let sensor = kinematics
+                .frame_pose(&robot.model, robot.ft_sensors[slot])
+                .translation
+                .vector;
+            // Moment about the world origin: r × F + τ; its x part must equal (c × W)_x.
+            moment_x += sensor.y * w[2] - sensor.z * w[1] + w[3];
+        }
+        assert!(
+            (moment_x - m.com.y * weight).abs() < 1e-6 * weight,
+            "{name}: {moment_x}"
+        );
+    }
+}
+
+#[test]
+fn holding_still_keeps_everything_fixed_and_deterministic() {
+    let robot = robot("jvrc1");
+    let mut a = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
+    let q: Vec<f64> = robot.standing.joints.iter().copied().collect();
+    let zeros = vec![0.0; q.len()];
+    for _ in 0..100 {
+        a.step(&q, &zeros, 0.002).unwrap();
+    }
+    let start = robot.standing.base.translation.vector;
+    assert!((a.configuration().base.translation.vector - start).norm() < 1e-12);
+    assert_eq!(a.summary().max_contact_slip, 0.0);
+    assert_eq!(a.summary().joint_limit_violations, 0);
+}
+
+#[test]
+fn bending_one_knee_lifts_that_foot_and_releases_it() {
+    let robot = robot("jvrc1");
+    let mut sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
+    let mut q: Vec<f64> = robot.standing.joints.iter().copied().collect();
+    let zeros = vec![0.0; q.len()];
+    let hip = leg_joint(&robot, false, "hip_p");
+    let knee = leg_joint(&robot, false, "knee");
+    for _ in 0..50 {
+        q[hip] -= 0.004;
+        q[knee] += 0.008;
+        sim.step(&q, &zeros, 0.002).unwrap();
+    }
+    // Swinging the free leg around moves nothing that stands.
+    let ankle = leg_joint(&robot, false, "ankle_p");
+    for _ in 0..50 {
+        q[ankle] += 0.004;
+        q[hip] -= 0.004;
+        sim.step(&q, &zeros, 0.002).unwrap();
+        assert!(
+            sim.measurement().safety.contact_slip < 1e-12,
+            "slip {}",
+            sim.measurement().safety.contact_slip
+        );
+    }
+    let m = sim.measurement();
+    assert!(
+        !m.contacts[EndEffector::RightFoot as usize],
+        "right foot lifted off"
+    );
+    assert!(m.contacts[EndEffector::LeftFoot as usize]);
+    assert_eq!(m.wrenches[EndEffector::RightFoot as usize][2], 0.0);
+    // The CoM sits between the feet, so standing on the left foot alone is a fall.
+    assert!(m.safety.stability_margin < 0.0);
+    assert!(sim.summary().fell);
+}
+
+#[test]
+fn commands_beyond_limits_stop_there_and_are_counted_and_bad_commands_are_refused() {
+    let robot = robot("jvrc1");
+    let mut sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
+    let mut q: Vec<f64> = robot.standing.joints.iter().copied().collect();
+    let zeros = vec![0.0; q.len()];
+    let arm = robot.joint_groups.arms[0];
+    q[arm] = robot.model.joint_limits()[arm].upper + 0.5;
+    sim.step(&q, &zeros, 0.002).unwrap();
+    assert_eq!(sim.measurement().safety.limit_violations, 1);
+    assert_eq!(
+        sim.measurement().q[arm],
+        robot.model.joint_limits()[arm].upper
+    );
+    q[arm] = f64::NAN;
+    assert!(
+        matches!(sim.step(&q, &zeros, 0.002), Err(SimError::NonFiniteCommand { index, .. }) if index == arm)
+    );
+    assert!(matches!(
+        sim.step(&q[1..], &zeros, 0.002),
+        Err(SimError::CommandLength { .. })
+    ));
+}
+
+#[test]
+fn a_robot_in_the_air_is_refused() {
+    let robot = robot("jvrc1");
+    let mut lifted = robot.standing.clone();
+    lifted.base.translation.vector.z += 0.1;
+    assert!(matches!(
+        KinematicSim::new(robot, lifted),
+        Err(SimError::NotStanding { .. })
+    ));
+}
+
+#[test]
+fn moving_every_joint_in_single_support_keeps_the_stance_foot_in_place() {
+    // Regression: composing the base with inverse poses every step used to let the quaternion
+    // norm error double per step until the base diverged.
+    let robot = robot("jvrc1");
+    let mut sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
+    let mut q: Vec<f64> = robot.standing.joints.iter().copied().collect();
+    let zeros = vec![0.0; q.len()];
+    let (hip, knee) = (
+        leg_joint(&robot, false, "hip_p"),
+        leg_joint(&robot, false, "knee"),
+    );
+    for _ in 0..50 {
+        q[hip] -= 0.004;
+        q[knee] += 0.008;
+        sim.step(&q, &zeros, 0.005).unwrap();
+    }
+    assert_eq!(sim.measurement().contacts, [true, false, false, false]);
+    for k in 0..2000 {
+        for (j, (v, limit)) in q.iter_mut().zip(robot.model.joint_limits()).enumerate() {
+            *v = (*v + 0.002 * ((j * 7 + k) as f64).sin()).clamp(limit.lower, limit.upper);
+        }
+        sim.step(&q, &zeros, 0.005).unwrap();
+        assert!(
+            sim.measurement().safety.contact_slip < 1e-12,
+            "step {k}: slip {}",
+            sim.measurement().safety.contact_slip
+        );
+    }
+}
