@@ -1,13 +1,14 @@
 //! Forward kinematics, centre of mass and Jacobians in a reusable workspace.
 //!
 //! [`Kinematics::update`] evaluates every link pose and the centre of mass in one pass over the
-//! links in depth-first order; the Jacobian functions then read those results. Nothing allocates
-//! after [`Kinematics::new`].
+//! links in depth-first order; the Jacobian functions then read those results. When only a few
+//! frame poses are needed, [`Kinematics::update_frames`] evaluates just the links on their ancestor
+//! chains (a [`FrameSet`] precomputed once). Nothing allocates after [`Kinematics::new`].
 
 use nalgebra::{DMatrix, Isometry3, Vector3};
 
 use crate::configuration::Configuration;
-use crate::model::{FrameId, JointMotion, LinkId, Model};
+use crate::model::{Body, FrameId, JointMotion, LinkId, Model};
 
 /// World poses of all links, the centre of mass, and the per-joint data the Jacobians need.
 #[derive(Debug, Clone)]
@@ -19,6 +20,48 @@ pub struct Kinematics {
     /// Per link: Σ mᵢ·cᵢ over the link's subtree (world frame).
     subtree_moments: Vec<Vector3<f64>>,
     com: Vector3<f64>,
+}
+
+/// The links [`Kinematics::update_frames`] must evaluate to pose a fixed set of frames: the union
+/// of the frames' ancestor chains (base to attached link), in link order so parents come first.
+/// Built once per model and frame list, so the update itself does not allocate.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FrameSet {
+    /// Link indices in increasing (depth-first, parent-first) order, without duplicates.
+    links: Vec<usize>,
+    /// Link count of the model the set was built for (guards against mixing models).
+    link_count: usize,
+}
+
+impl FrameSet {
+    /// The ancestor links of `frames` in `model`.
+    ///
+    /// # Panics
+    /// If a frame id does not belong to `model`.
+    pub fn new(model: &Model, frames: &[FrameId]) -> Self {
+        let bodies = model.bodies();
+        let mut needed = vec![false; bodies.len()];
+        for &frame in frames {
+            let mut link = Some(model.frame_link(frame).index());
+            while let Some(l) = link {
+                if needed[l] {
+                    break;
+                }
+                needed[l] = true;
+                link = bodies[l].parent;
+            }
+        }
+        let links = (0..bodies.len()).filter(|&l| needed[l]).collect();
+        Self {
+            links,
+            link_count: bodies.len(),
+        }
+    }
+
+    /// The links evaluated, in evaluation order.
+    pub fn links(&self) -> impl ExactSizeIterator<Item = LinkId> + '_ {
+        self.links.iter().map(|&l| LinkId(l))
+    }
 }
 
 impl Kinematics {
@@ -49,26 +92,7 @@ impl Kinematics {
         );
         let bodies = model.bodies();
         for (i, body) in bodies.iter().enumerate() {
-            let pose = match body.parent {
-                None => q.base,
-                Some(parent) => {
-                    let mut pose = self.poses[parent] * body.origin;
-                    match body.motion {
-                        JointMotion::Fixed => {}
-                        JointMotion::Revolute { axis, index } => {
-                            self.axes[index] = pose.rotation * axis.into_inner();
-                            pose.rotation *=
-                                nalgebra::UnitQuaternion::from_axis_angle(&axis, q.joints[index]);
-                        }
-                        JointMotion::Prismatic { axis, index } => {
-                            let world_axis = pose.rotation * axis.into_inner();
-                            self.axes[index] = world_axis;
-                            pose.translation.vector += world_axis * q.joints[index];
-                        }
-                    }
-                    pose
-                }
-            };
+            let pose = self.place_link(body, q);
             self.subtree_moments[i] =
                 (pose.translation.vector + pose.rotation * body.com) * body.mass;
             self.poses[i] = pose;
@@ -85,6 +109,60 @@ impl Kinematics {
         } else {
             self.poses[0].translation.vector
         };
+    }
+
+    /// Forward kinematics of only the links on the ancestor chains of `frames` at `q`: afterwards
+    /// [`Kinematics::frame_pose`] of those frames (and [`Kinematics::link_pose`] of those links)
+    /// equal what [`Kinematics::update`] gives, while every other link pose, the centre of mass,
+    /// and all Jacobians still hold stale values from an earlier update and must not be read.
+    /// Does not allocate.
+    ///
+    /// # Panics
+    /// If `q.joints` does not have `model.dof()` entries, or the workspace or `frames` was built
+    /// for another model.
+    pub fn update_frames(&mut self, model: &Model, q: &Configuration, frames: &FrameSet) {
+        assert_eq!(
+            q.joints.len(),
+            model.dof(),
+            "Kinematics::update_frames: wrong joint count"
+        );
+        assert_eq!(
+            self.poses.len(),
+            model.link_count(),
+            "Kinematics::update_frames: workspace of another model"
+        );
+        assert_eq!(
+            frames.link_count,
+            model.link_count(),
+            "Kinematics::update_frames: frame set of another model"
+        );
+        let bodies = model.bodies();
+        for &link in &frames.links {
+            self.poses[link] = self.place_link(&bodies[link], q);
+        }
+    }
+
+    /// World pose of `body` from its parent's (already updated) pose and its joint value; records
+    /// the world axis of its joint. Shared by both updates so their poses agree bit for bit.
+    #[inline(always)]
+    fn place_link(&mut self, body: &Body, q: &Configuration) -> Isometry3<f64> {
+        let Some(parent) = body.parent else {
+            return q.base;
+        };
+        let mut pose = self.poses[parent] * body.origin;
+        match body.motion {
+            JointMotion::Fixed => {}
+            JointMotion::Revolute { axis, index } => {
+                self.axes[index] = pose.rotation * axis.into_inner();
+                pose.rotation *= nalgebra::UnitQuaternion::from_axis_angle(&axis, q.joints[index]);
+            }
+            JointMotion::Prismatic { axis, index } => {
+                let world_axis = pose.rotation * axis.into_inner();
+                self.axes[index] = world_axis;
+                pose.translation.vector += world_axis * q.joints[index];
+            }
+        }
+        pose
     }
 
     /// World pose of a link (after [`Kinematics::update`]).

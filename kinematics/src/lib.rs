@@ -22,6 +22,6 @@ pub use nalgebra::{DMatrix, DVector, Isometry3, Translation3, UnitQuaternion, Ve
 
 pub use configuration::Configuration;
 pub use ik::{IkError, IkOptions, IkSolution, IkSolver, IkTarget};
-pub use kinematics::Kinematics;
+pub use kinematics::{FrameSet, Kinematics};
 pub use model::{FrameId, JointLimits, LinkId, Model, ModelError};
 pub use robot::{EndEffector, JointGroups, Robot, RobotError, SoleRectangle};

@@ -107,6 +107,9 @@ pub const FT_SENSOR_FRAMES: [&str; 2] = ["left_ft_sensor", "right_ft_sensor"];
 pub struct Robot {
     /// Robot name from the config.
     pub name: String,
+    /// The URDF file the model was loaded from (physics back-ends need what the kinematic model
+    /// does not keep, such as inertia tensors).
+    pub urdf: PathBuf,
     /// The kinematic model, with the end-effector and FT sensor frames added.
     pub model: Model,
     /// The link the config calls the floating base (for base orientation tasks).
@@ -276,13 +279,15 @@ impl Robot {
                 });
             }
         };
-        let model =
-            Model::from_urdf_path(&urdf).map_err(|source| RobotError::Model { urdf, source })?;
+        let model = Model::from_urdf_path(&urdf).map_err(|source| RobotError::Model {
+            urdf: urdf.clone(),
+            source,
+        })?;
         Loader {
             path: config,
             model,
         }
-        .build(section)
+        .build(section, urdf)
     }
 
     /// The frame of an end-effector.
@@ -298,7 +303,7 @@ struct Loader<'a> {
 }
 
 impl Loader<'_> {
-    fn build(mut self, section: RobotSection) -> Result<Robot, RobotError> {
+    fn build(mut self, section: RobotSection, urdf: PathBuf) -> Result<Robot, RobotError> {
         let base_link = self.link("base_link", &section.base_link)?;
         self.check_sole(&section.sole)?;
         let frames = &section.frames;
@@ -341,6 +346,7 @@ impl Loader<'_> {
         let standing = self.standing(&section.standing, [end_effectors[0], end_effectors[1]])?;
         Ok(Robot {
             name: section.name,
+            urdf,
             model: self.model,
             base_link,
             end_effectors,

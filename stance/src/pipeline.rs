@@ -2,7 +2,7 @@
 //! passes, and the post-processed sequence — with buffers reused across calls.
 
 use kinematics::robot::{EndEffector, Robot};
-use kinematics::{Configuration, Kinematics};
+use kinematics::{Configuration, FrameSet, Kinematics};
 use nalgebra::{Isometry3, Translation3, Vector3};
 
 use crate::error::FormatError;
@@ -17,6 +17,8 @@ pub struct PostProcessor<'r> {
     robot: &'r Robot,
     params: PostProcessParams,
     kinematics: Kinematics,
+    /// The links on the four end-effectors' ancestor chains: all that forward kinematics needs.
+    effector_links: FrameSet,
     configuration: Configuration,
     poses: PoseSequence,
 }
@@ -28,6 +30,7 @@ impl<'r> PostProcessor<'r> {
             robot,
             params,
             kinematics: Kinematics::new(&robot.model),
+            effector_links: FrameSet::new(&robot.model, &EndEffector::ALL.map(|e| robot.frame(e))),
             configuration: robot.standing.clone(),
             poses: PoseSequence::default(),
         }
@@ -53,7 +56,8 @@ impl<'r> PostProcessor<'r> {
                 .joints
                 .as_mut_slice()
                 .copy_from_slice(&stance.q);
-            self.kinematics.update(model, &self.configuration);
+            self.kinematics
+                .update_frames(model, &self.configuration, &self.effector_links);
             let poses =
                 EndEffector::ALL.map(|e| self.kinematics.frame_pose(model, self.robot.frame(e)));
             self.poses
