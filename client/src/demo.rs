@@ -1,0 +1,339 @@
+//! `walkctl demo`: the whole system in one command.
+//!
+//! Starts `walkd` and `walk-sim` as child processes (found next to `walkctl`'s own executable),
+//! unless a `walkd` already serves the robot's services; generates a walk, post-processes it,
+//! submits it, watches it, prints the outcome and shuts the children down with SIGTERM.
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, bail};
+use kinematics::robot::Robot;
+use shm_types::{ClockMode, DaemonState, DaemonStatus, LatencySummary, LinkState, RuntimeConfig};
+
+use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
+use crate::watch::StanceProgress;
+
+/// The robots with a vendored config.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DemoRobot {
+    /// KIT ARMAR-4.
+    Armar4,
+    /// JVRC-1.
+    Jvrc1,
+    /// Kawada HRP-4 (needs --urdf: its model is not vendored).
+    Hrp4,
+}
+
+impl DemoRobot {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Armar4 => "armar4",
+            Self::Jvrc1 => "jvrc1",
+            Self::Hrp4 => "hrp4",
+        }
+    }
+}
+
+/// Simulator backends `walk-sim` offers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DemoPhysics {
+    /// The deterministic kinematic simulator.
+    Kinematic,
+}
+
+/// Arguments of `walkctl demo`.
+#[derive(Debug, clap::Args)]
+pub struct DemoArgs {
+    /// Robot to walk.
+    #[arg(long, value_enum, default_value = "armar4")]
+    pub robot: DemoRobot,
+    /// Distance to walk forward (m).
+    #[arg(long, default_value_t = 1.0)]
+    pub distance: f64,
+    /// Simulator backend of the started `walk-sim`.
+    #[arg(long, value_enum, default_value = "kinematic")]
+    pub physics: DemoPhysics,
+    /// Clock of the started processes: realtime (at the config's rate) or lockstep (fast).
+    #[arg(long, default_value = "realtime")]
+    pub clock: ClockMode,
+    /// Control rate of the started processes, overriding the config's.
+    #[arg(long)]
+    pub rate_hz: Option<f64>,
+    /// Robot config (default: configs/<robot>.toml in the current directory or the source tree).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// URDF overriding the config's (required for HRP-4).
+    #[arg(long)]
+    pub urdf: Option<PathBuf>,
+    /// Service prefix, overriding the config's (to run beside another daemon).
+    #[arg(long)]
+    pub service_prefix: Option<String>,
+    /// Seed of the stance generator.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What the demo measured.
+#[derive(Debug, Clone)]
+pub struct DemoOutcome {
+    /// The final daemon status.
+    pub status: DaemonStatus,
+    /// Forward distance the feet midpoint covered (m).
+    pub distance_m: f64,
+    /// Stances completed.
+    pub stances: u32,
+}
+
+impl DemoOutcome {
+    /// `done`, or the fault / state the walk ended in.
+    pub fn outcome(&self) -> String {
+        match self.status.state {
+            DaemonState::Done => "done".to_owned(),
+            DaemonState::Fault => format!("fault: {}", self.status.fault),
+            other => format!("{}: {}", other.name(), self.status.fault),
+        }
+    }
+
+    fn json(&self) -> serde_json::Value {
+        let tick =
+            |s: &LatencySummary| serde_json::json!({"p50": s.p50, "p99": s.p99, "max": s.max});
+        serde_json::json!({
+            "outcome": self.outcome(),
+            "distance_m": self.distance_m,
+            "stances": self.stances,
+            "deadline_misses": self.status.deadline_misses,
+            "tick_us": tick(&self.status.tick_us),
+            "latency_us": tick(&self.status.latency_us),
+            "clock": self.status.clock.name(),
+            "rate_hz": self.status.rate_hz,
+        })
+    }
+}
+
+/// The config of `robot`: `configs/<robot>.toml` in the current directory, else in the source
+/// tree the executable was built in (`target/<profile>/../../configs`).
+fn default_config(robot: DemoRobot) -> anyhow::Result<PathBuf> {
+    let file = format!("{}.toml", robot.name());
+    let mut candidates = vec![Path::new("configs").join(&file)];
+    if let Some(dir) = executable_dir() {
+        candidates.push(dir.join("../../configs").join(&file));
+    }
+    candidates
+        .iter()
+        .find(|path| path.is_file())
+        .cloned()
+        .with_context(|| {
+            format!(
+                "no config for {} found (looked at {candidates:?}); pass --config",
+                robot.name()
+            )
+        })
+}
+
+fn executable_dir() -> Option<PathBuf> {
+    std::env::current_exe().ok()?.parent().map(Path::to_owned)
+}
+
+/// Child processes started by the demo; stopped with SIGTERM when dropped.
+struct Children(Vec<(&'static str, Child)>);
+
+impl Children {
+    fn spawn(&mut self, name: &'static str, args: &[OsString]) -> anyhow::Result<()> {
+        let binary = executable_dir()
+            .map(|dir| dir.join(name))
+            .filter(|path| path.is_file())
+            .with_context(|| format!("`{name}` not found next to walkctl (build all binaries)"))?;
+        let child = Command::new(&binary)
+            .args(args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .with_context(|| format!("cannot start {}", binary.display()))?;
+        self.0.push((name, child));
+        Ok(())
+    }
+
+    /// SIGTERM to each child (newest first), waiting up to 5 s each, then SIGKILL.
+    fn shut_down(&mut self) -> Vec<String> {
+        let mut problems = Vec::new();
+        while let Some((name, mut child)) = self.0.pop() {
+            // SAFETY: kill with a pid of our own child has no memory-safety preconditions.
+            unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+            let start = Instant::now();
+            loop {
+                match child.try_wait() {
+                    Ok(Some(status)) if status.success() => break,
+                    Ok(Some(status)) => {
+                        problems.push(format!("{name} exited with {status}"));
+                        break;
+                    }
+                    Ok(None) if start.elapsed() < Duration::from_secs(5) => {
+                        std::thread::sleep(Duration::from_millis(10));
+                    }
+                    _ => {
+                        let _ = child.kill();
+                        let _ = child.wait();
+                        problems.push(format!("{name} did not stop on SIGTERM; killed"));
+                        break;
+                    }
+                }
+            }
+        }
+        problems
+    }
+}
+
+impl Drop for Children {
+    fn drop(&mut self) {
+        self.shut_down();
+    }
+}
+
+/// Waits until a daemon serves `prefix` and its adapter link is fresh.
+fn wait_for_daemon(
+    prefix: &str,
+    children: &mut Children,
+    timeout: Duration,
+) -> anyhow::Result<DaemonClient> {
+    let start = Instant::now();
+    loop {
+        for (name, child) in &mut children.0 {
+            if let Ok(Some(status)) = child.try_wait() {
+                bail!("{name} exited during start-up ({status})");
+            }
+        }
+        if let Ok(client) = DaemonClient::connect(prefix)
+            && client.is_running()
+            && let Ok(status) = client.status()
+            && status.link == LinkState::Fresh
+        {
+            return Ok(client);
+        }
+        if start.elapsed() > timeout {
+            bail!(
+                "walkd on `{prefix}` did not get fresh samples within {} s",
+                timeout.as_secs()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// Generates and post-processes a forward walk of `distance` for `robot` (config `config`);
+/// returns the sequence's JSON and its number of stances.
+pub fn walk_sequence(
+    robot: &Robot,
+    config: &Path,
+    distance: f64,
+    seed: u64,
+) -> anyhow::Result<(String, usize)> {
+    let params = stance::PostProcessParams::from_config_path(config)?;
+    let raw = stance::generate(
+        robot,
+        &stance::GenerateOptions {
+            distance: distance / params.scf,
+            affordances: stance::AffordanceSet::Feet,
+            seed,
+        },
+    )?;
+    let processed = stance::PostProcessor::new(robot, params).process(&raw)?;
+    Ok((processed.to_json_string(), processed.len()))
+}
+
+/// Runs the demo and returns what it measured (also used by the e2e tests).
+pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
+    let config = match &args.config {
+        Some(config) => config.clone(),
+        None => default_config(args.robot)?,
+    };
+    let runtime = RuntimeConfig::from_config_file(&config)?;
+    let prefix = args
+        .service_prefix
+        .clone()
+        .unwrap_or(runtime.service_prefix);
+    let robot = Robot::load(&config, args.urdf.as_deref())?;
+    let (json, stance_count) = walk_sequence(&robot, &config, args.distance, args.seed)?;
+
+    let mut children = Children(Vec::new());
+    let running = DaemonClient::connect(&prefix).is_ok_and(|client| client.is_running());
+    if !running {
+        let mut common: Vec<OsString> = vec![
+            "--config".into(),
+            config.clone().into(),
+            "--service-prefix".into(),
+            prefix.clone().into(),
+            "--clock".into(),
+            args.clock.name().into(),
+        ];
+        if let Some(urdf) = &args.urdf {
+            common.extend(["--urdf".into(), urdf.clone().into()]);
+        }
+        if let Some(rate) = args.rate_hz {
+            common.extend(["--rate-hz".into(), rate.to_string().into()]);
+        }
+        children.spawn("walkd", &common)?;
+        let physics = match args.physics {
+            DemoPhysics::Kinematic => "kinematic",
+        };
+        let mut sim_args = common;
+        sim_args.extend(["--physics".into(), physics.into()]);
+        children.spawn("walk-sim", &sim_args)?;
+    }
+    let client = wait_for_daemon(&prefix, &mut children, Duration::from_secs(20))?;
+    let start = client.status()?;
+    let id = client.submit_json(&json)?;
+    let progress = (!args.json).then(StanceProgress::new);
+    let timeout = Duration::from_secs(60 + 30 * stance_count as u64);
+    let last = client.wait_for_sequence(id, timeout, |status| {
+        if let Some(progress) = &progress {
+            progress.update(status);
+        }
+    })?;
+    if let Some(progress) = &progress {
+        progress.finish();
+    }
+    // Let a final status with the complete tick statistics arrive.
+    let status = client.status().unwrap_or(last);
+    drop(client);
+    let problems = children.shut_down();
+    if !problems.is_empty() {
+        bail!("shutting down: {}", problems.join("; "));
+    }
+    let stances = if status.state == DaemonState::Done {
+        status.stance_count
+    } else {
+        status.stance_index
+    };
+    Ok(DemoOutcome {
+        distance_m: feet_midpoint(&status)[0] - feet_midpoint(&start)[0],
+        stances,
+        status,
+    })
+}
+
+/// `walkctl demo`: runs the demo and prints the outcome; fails unless the walk is done.
+pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
+    let outcome = run_demo(args)?;
+    if args.json {
+        println!("{}", outcome.json());
+    } else {
+        println!(
+            "outcome: {}\ndistance covered: {:.3} m\nstances executed: {}\n{}",
+            outcome.outcome(),
+            outcome.distance_m,
+            outcome.stances,
+            status_text(&outcome.status)
+        );
+    }
+    if outcome.status.state != DaemonState::Done {
+        bail!("the walk did not complete: {}", outcome.outcome());
+    }
+    Ok(())
+}
