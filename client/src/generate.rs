@@ -39,6 +39,8 @@ pub struct GenerateArgs {
     pub output: PathBuf,
     #[command(flatten)]
     pub params: ParamOverrides,
+    #[command(flatten)]
+    pub source: crate::learn::SourceArgs,
 }
 
 fn parse_interval(text: &str) -> Result<[f64; 2], String> {
@@ -65,7 +67,13 @@ pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
         affordances: args.affordances,
         seed: args.seed,
     };
-    let raw = generate_with_railing(&robot, &options, railing)?;
+    let learned = args
+        .source
+        .generate(&robot, distance, args.affordances, railing, args.seed)?;
+    let raw = match learned {
+        Some(learned) => learned,
+        None => generate_with_railing(&robot, &options, railing)?,
+    };
     std::fs::write(&args.output, raw.to_json_string())
         .with_context(|| format!("writing {}", args.output.display()))?;
     eprintln!(

@@ -1,1 +1,39 @@
-//! Stance sequences: data model, file format, human-like source and post-processing (Algorithm 1).
+//! Stance sequences: data model, file format, human-like source and post-processing
+//! (Algorithm 1 of Grimm, Kheddar, Asfour; DESIGN.md §3–4).
+//!
+//! - [`Stance`], [`RawSequence`], [`PostProcessedSequence`], [`Environment`]: the data model,
+//!   validated on construction and read/written as versioned JSON ([`format`]).
+//! - [`PoseSequence`]: world poses of root and end-effectors per stance, the passes' working form.
+//! - [`passes`]: the nine passes, each a function; [`PostProcessor`] runs FK + all passes with
+//!   reusable buffers.
+//! - [`generate()`]: a human-like, impeded stance source (until an n-gram generator exists).
+//! - [`derived`]: step sizes, swing heights, orthogonal foot distances.
+//!
+//! Conventions: world z up, metres, radians; quaternions `[x, y, z, w]` in files; end-effector
+//! arrays are indexed by `kinematics::robot::EndEffector as usize`.
+
+pub mod derived;
+pub mod environment;
+pub mod error;
+pub mod format;
+pub mod generate;
+pub mod geometry;
+mod json_path;
+pub mod learned;
+pub mod params;
+pub mod passes;
+mod pipeline;
+pub mod plot;
+pub mod poses;
+pub mod sequence;
+
+pub use environment::{Environment, HandAffordance, SupportSurface};
+pub use error::{FormatError, Location};
+pub use generate::{
+    AffordanceSet, GenerateError, GenerateOptions, generate, generate_with_railing,
+};
+pub use geometry::PathFrame;
+pub use params::{ContactUnification, ParamsError, PostProcessParams};
+pub use pipeline::PostProcessor;
+pub use poses::PoseSequence;
+pub use sequence::{PostProcessedSequence, RawSequence, Stance};

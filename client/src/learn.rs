@@ -1,0 +1,180 @@
+//! `walkctl learn`: train the n-gram stance model on demonstration folders (each with a
+//! `demo.toml` manifest) and write it as JSON; optionally report realism against a held-out
+//! folder. Also the learned stance source of `walkctl generate` ([`SourceArgs`]).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use kinematics::robot::Robot;
+use stance::learned::realism::{WalkStatistics, of_generated, of_keyframes};
+use stance::learned::{
+    LearnedOptions, NgramModel, Query, Search, SegmentOptions, TrainOptions, generate_learned,
+    generate_tokens, load_folder, segment, taxonomy_label,
+};
+use stance::{AffordanceSet, RawSequence};
+
+/// Arguments of `walkctl learn`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct LearnArgs {
+    /// Demonstration folders, each with a demo.toml (e.g. data/demonstrations/gaitalytics).
+    #[arg(long, value_name = "DIR", num_args = 1.., required = true)]
+    pub demos: Vec<PathBuf>,
+    /// Where to write the model.
+    #[arg(short, long, value_name = "MODEL.json")]
+    pub output: PathBuf,
+    /// Order n of the n-gram.
+    #[arg(long, default_value_t = 3)]
+    pub order: usize,
+    /// Absolute discount of the smoothing, in (0, 1).
+    #[arg(long, default_value_t = 0.75)]
+    pub discount: f64,
+    /// Largest number of pose clusters per taxonomy class.
+    #[arg(long, default_value_t = 8)]
+    pub max_clusters: usize,
+    /// Do not add left-right mirrored copies of the demonstrations.
+    #[arg(long)]
+    pub no_mirror: bool,
+    /// A held-out demonstration folder: print step length, step width and stance duration of
+    /// generated sequences against it.
+    #[arg(long, value_name = "DIR")]
+    pub holdout: Option<PathBuf>,
+}
+
+/// Runs `walkctl learn`.
+pub fn run(args: &LearnArgs) -> anyhow::Result<()> {
+    let mut demos = Vec::new();
+    for dir in &args.demos {
+        demos.extend(load_folder(dir)?);
+    }
+    let options = TrainOptions {
+        order: args.order,
+        discount: args.discount,
+        max_clusters: args.max_clusters,
+        mirror: !args.no_mirror,
+        ..TrainOptions::default()
+    };
+    for demo in &demos {
+        let keyframes = segment(demo, &options.segment).keyframes;
+        let mut classes: Vec<(String, usize)> = Vec::new();
+        for k in &keyframes {
+            let label = taxonomy_label(k.contacts);
+            match classes.iter_mut().find(|(l, _)| *l == label) {
+                Some((_, n)) => *n += 1,
+                None => classes.push((label, 1)),
+            }
+        }
+        let classes: Vec<String> = classes.iter().map(|(l, n)| format!("{l} {n}")).collect();
+        eprintln!(
+            "{}: {} frames at {} Hz, {} stances ({})",
+            demo.name,
+            demo.len(),
+            demo.rate,
+            keyframes.len(),
+            classes.join(", ")
+        );
+    }
+    let model = NgramModel::train(&demos, &options)?;
+    std::fs::write(&args.output, model.to_json_string() + "\n")
+        .with_context(|| format!("writing {}", args.output.display()))?;
+    eprintln!(
+        "{}: order {}, {} tokens, {} contexts, human pelvis height {:.3} m",
+        args.output.display(),
+        model.order,
+        model.tokens.len(),
+        model.counts.len(),
+        model.human_pelvis_height
+    );
+    if let Some(dir) = &args.holdout {
+        print_realism(&model, dir)?;
+    }
+    Ok(())
+}
+
+/// Prints the realism report: the held-out trials against the most probable and ten sampled
+/// 10 m sequences (human scale).
+fn print_realism(model: &NgramModel, dir: &Path) -> anyhow::Result<()> {
+    let held_out = load_folder(dir)?;
+    for demo in &held_out {
+        let keyframes = segment(demo, &SegmentOptions::default()).keyframes;
+        print_statistics(
+            &format!("held-out {}", demo.name),
+            &of_keyframes(&keyframes),
+        );
+    }
+    let query = |search| Query {
+        distance: 10.0,
+        hands: [Vec::new(), Vec::new()],
+        search,
+    };
+    let beam = generate_tokens(model, &query(Search::Beam(8)))?;
+    print_statistics("generated, beam search", &of_generated(model, &beam));
+    let mut pooled = generate_tokens(model, &query(Search::Sample(0)))?;
+    for seed in 1..10 {
+        let generated = generate_tokens(model, &query(Search::Sample(seed)))?;
+        pooled.tokens.extend(generated.tokens);
+    }
+    print_statistics("generated, 10 samples", &of_generated(model, &pooled));
+    Ok(())
+}
+
+fn print_statistics(name: &str, statistics: &WalkStatistics) {
+    println!("{name}");
+    println!("  step length [m]     {}", statistics.step_length);
+    println!("  step width [m]      {}", statistics.step_width);
+    println!("  stance duration [s] {}", statistics.stance_duration);
+}
+
+/// The stance source options of `walkctl generate` (flattened into its arguments).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SourceArgs {
+    /// Stance source: `learned` (n-gram model, the default when --model is given) or `synthetic`.
+    #[arg(long, value_name = "SOURCE")]
+    pub source: Option<String>,
+    /// Trained n-gram model (see `walkctl learn`), e.g. data/models/default-ngram.json.
+    #[arg(long, value_name = "MODEL.json")]
+    pub model: Option<PathBuf>,
+    /// With a model: the most probable sequence (beam search of this width) instead of a
+    /// sequence sampled with --seed.
+    #[arg(long, value_name = "WIDTH")]
+    pub beam: Option<usize>,
+}
+
+impl SourceArgs {
+    /// Generates from the learned model when one is selected, `Ok(None)` for the synthetic
+    /// source. `distance` and `railing` (the part of the path where the railing is available)
+    /// are raw-scale metres (already divided by scf).
+    pub fn generate(
+        &self,
+        robot: &Robot,
+        distance: f64,
+        affordances: AffordanceSet,
+        railing: [f64; 2],
+        seed: u64,
+    ) -> anyhow::Result<Option<RawSequence>> {
+        let model_path = match (self.source.as_deref(), &self.model) {
+            (Some("synthetic"), _) | (None, None) => return Ok(None),
+            (Some("learned") | None, Some(path)) => path,
+            (Some("learned"), None) => bail!("--source learned needs --model MODEL.json"),
+            (Some(other), _) => bail!("unknown --source `{other}` (learned or synthetic)"),
+        };
+        let model = NgramModel::from_path(model_path)?;
+        let options = LearnedOptions {
+            distance,
+            affordances,
+            railing: Some(railing),
+            search: self.beam.map_or(Search::Sample(seed), Search::Beam),
+        };
+        let retargeted = generate_learned(robot, &model, &options)?;
+        let errors = &retargeted.ik_errors;
+        let worst = errors
+            .iter()
+            .fold([0.0f64; 2], |w, e| [w[0].max(e[0]), w[1].max(e[1])]);
+        eprintln!(
+            "retargeted {} stances: largest IK error {:.1e} m, {:.1e} rad",
+            errors.len(),
+            worst[0],
+            worst[1]
+        );
+        Ok(Some(retargeted.raw))
+    }
+}

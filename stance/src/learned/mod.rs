@@ -1,0 +1,27 @@
+//! Stance sequences learned from real human demonstrations (issue 7; the paper's stance source):
+//! readers for motion-capture files ([`c3d`], [`npy`], gaitkit JSON in [`demo`]), segmentation
+//! into stances with taxonomy labels ([`mod@segment`]), an n-gram model over stance tokens
+//! ([`model`]) with a hand-support part ([`hands`]), its query by distance and affordances
+//! ([`query`]), retargeting of the generated stances to a robot ([`retarget`]), realism
+//! statistics ([`realism`]) and the paper's Fig. 4 ([`coverage`]). See `docs/learning.md`.
+
+pub mod c3d;
+mod cluster;
+pub mod coverage;
+pub mod demo;
+pub mod error;
+pub mod hands;
+pub mod model;
+pub mod npy;
+pub mod query;
+pub mod realism;
+pub mod retarget;
+pub mod segment;
+
+pub use demo::{Demonstration, EventKind, GaitEvent, load_folder};
+pub use error::LearnError;
+pub use model::{NgramModel, TrainOptions};
+pub use query::{Generated, Query, Search, generate_tokens};
+pub use realism::{Distribution, WalkStatistics};
+pub use retarget::{LearnedOptions, Retargeted, generate_learned};
+pub use segment::{Keyframe, SegmentOptions, Segmentation, foot_events, segment, taxonomy_label};

@@ -1,0 +1,285 @@
+//! Retargeting generated human stances to a robot (the MMM analogue): human lengths are scaled
+//! by the robot's pelvis height over the human's, every stance's end-effector targets are laid
+//! out along the robot's walking direction, and a per-stance IK (weighted position and rotation
+//! errors, joints within limits, warm-started from the previous stance) gives `q_S` and the root
+//! pose. Nothing is cleaned up: the raw sequence keeps the demonstrations' natural impediments
+//! (jumping contacts, toe-out, pitched soles, uneven steps) for post-processing to remove.
+
+use kinematics::ik::{IkError, IkOptions, IkSolver, IkTarget};
+use kinematics::robot::{EndEffector, Robot};
+use kinematics::{Configuration, Kinematics};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+
+use super::error::LearnError;
+use super::model::NgramModel;
+use super::query::{Generated, Query, Search, generate_tokens};
+use crate::environment::{Environment, HandAffordance};
+use crate::generate::AffordanceSet;
+use crate::sequence::{RawSequence, Stance};
+
+/// What to generate with a learned model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LearnedOptions {
+    /// Distance to cover along the robot's forward direction (robot metres; divide by scf first
+    /// to cover it after post-processing).
+    pub distance: f64,
+    /// Which hands may hold the railing.
+    pub affordances: AffordanceSet,
+    /// Part of the path `[from, to]` (robot metres, same scale as `distance`) along which the
+    /// railing is available; `None` = the whole path.
+    pub railing: Option<[f64; 2]>,
+    /// Beam search (most probable) or seeded sampling.
+    pub search: Search,
+}
+
+/// The robot's walking frame and size, measured in its standing posture.
+struct RobotFrame {
+    /// Human-to-robot length scale.
+    scale: f64,
+    /// Unit walking direction (horizontal).
+    forward: Vector3<f64>,
+    /// Standing hand orientations in the world.
+    hand_rotations: [UnitQuaternion<f64>; 2],
+}
+
+impl RobotFrame {
+    fn measure(robot: &Robot, human_pelvis_height: f64) -> Self {
+        let model = &robot.model;
+        let mut kinematics = Kinematics::new(model);
+        kinematics.update(model, &robot.standing);
+        let pose = |e: EndEffector| kinematics.frame_pose(model, robot.frame(e));
+        let (left, right) = (pose(EndEffector::LeftFoot), pose(EndEffector::RightFoot));
+        let heading = left.rotation * Vector3::x() + right.rotation * Vector3::x();
+        let sole_z = 0.5 * (left.translation.z + right.translation.z);
+        let pelvis = kinematics.link_pose(robot.base_link).translation.z - sole_z;
+        Self {
+            scale: pelvis / human_pelvis_height,
+            forward: Vector3::new(heading.x, heading.y, 0.0).normalize(),
+            hand_rotations: [
+                pose(EndEffector::LeftHand).rotation,
+                pose(EndEffector::RightHand).rotation,
+            ],
+        }
+    }
+
+    fn heading(&self) -> f64 {
+        self.forward.y.atan2(self.forward.x)
+    }
+
+    /// World point of human path coordinates (along, lateral, height), scaled.
+    fn point(&self, human: Vector3<f64>) -> Vector3<f64> {
+        let lateral = Vector3::z().cross(&self.forward);
+        (self.forward * human.x + lateral * human.y + Vector3::z() * human.z) * self.scale
+    }
+}
+
+/// Per-stance world targets (robot scale) of a generated token sequence.
+struct StanceTargets {
+    contacts: [bool; 4],
+    targets: [Option<Isometry3<f64>>; 4],
+    root: Vector3<f64>,
+}
+
+fn lay_out(model: &NgramModel, generated: &Generated, frame: &RobotFrame) -> Vec<StanceTargets> {
+    let heading = frame.heading();
+    generated
+        .tokens
+        .iter()
+        .zip(&generated.progress)
+        .zip(&generated.hands)
+        .map(|((&id, &along), &hands)| {
+            let token = model.token(id);
+            let root = Vector3::new(along, 0.0, token.root_height);
+            let contacts = [token.contacts[0], token.contacts[1], hands[0], hands[1]];
+            let mut targets = [None; 4];
+            for e in EndEffector::ALL {
+                let k = e as usize;
+                if !e.is_foot() && !contacts[k] {
+                    continue;
+                }
+                // A grasp the hand-support model added takes that model's mean grasp pose.
+                let added = || {
+                    let feet = [contacts[0], contacts[1]];
+                    model.hand_support(feet, k - 2).and_then(|h| h.pose)
+                };
+                let pose = match token.effectors[k] {
+                    Some(pose) if e.is_foot() || token.contacts[k] => Some(pose),
+                    _ => added(),
+                };
+                let Some(pose) = pose else {
+                    continue;
+                };
+                let position = frame.point(root + Vector3::from(pose.position));
+                let rotation = if e.is_foot() {
+                    UnitQuaternion::from_axis_angle(&Vector3::z_axis(), heading + pose.yaw)
+                        * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), pose.pitch)
+                } else {
+                    frame.hand_rotations[k - 2]
+                };
+                targets[k] = Some(Isometry3::from_parts(
+                    Translation3::from(position),
+                    rotation,
+                ));
+            }
+            StanceTargets {
+                contacts,
+                targets,
+                root: frame.point(root),
+            }
+        })
+        .collect()
+}
+
+/// Hand availability along the human-scale path for an affordance set and railing interval.
+fn hand_intervals(set: AffordanceSet, interval: [f64; 2]) -> [Vec<[f64; 2]>; 2] {
+    let all = vec![interval];
+    match set {
+        AffordanceSet::Feet => [Vec::new(), Vec::new()],
+        AffordanceSet::FeetLeftHand => [all, Vec::new()],
+        AffordanceSet::FeetRightHand => [Vec::new(), all],
+    }
+}
+
+/// A retargeted sequence with what it came from and how well the IK met its targets.
+#[derive(Clone, Debug)]
+pub struct Retargeted {
+    /// The raw robot sequence.
+    pub raw: RawSequence,
+    /// The generated human-scale token sequence.
+    pub generated: Generated,
+    /// Per stance, the IK's remaining `[position error (m), orientation error (rad)]`.
+    pub ik_errors: Vec<[f64; 2]>,
+}
+
+/// Generates a raw stance sequence for `robot` from a learned model: query (human scale),
+/// lay-out, per-stance IK.
+pub fn generate_learned(
+    robot: &Robot,
+    model: &NgramModel,
+    options: &LearnedOptions,
+) -> Result<Retargeted, LearnError> {
+    let frame = RobotFrame::measure(robot, model.human_pelvis_height);
+    let human_distance = options.distance / frame.scale;
+    let railing = options.railing.unwrap_or([0.0, options.distance]);
+    let query = Query {
+        distance: human_distance,
+        hands: hand_intervals(options.affordances, railing.map(|s| s / frame.scale)),
+        search: options.search,
+    };
+    let generated = generate_tokens(model, &query)?;
+    let layout = lay_out(model, &generated, &frame);
+    let (stances, ik_errors) = solve(robot, &layout)?;
+    let environment = environment(&layout, options, &frame);
+    let raw = RawSequence::new(
+        robot.name.clone(),
+        robot.model.joint_names().to_vec(),
+        environment,
+        stances,
+    )
+    .map_err(|e| LearnError::Retarget(e.to_string()))?;
+    Ok(Retargeted {
+        raw,
+        generated,
+        ik_errors,
+    })
+}
+
+/// The ground plus, for a hand set, a railing through the generated grasps (or beside the
+/// standing hand if the model generated none), available along the whole path.
+fn environment(
+    layout: &[StanceTargets],
+    options: &LearnedOptions,
+    frame: &RobotFrame,
+) -> Environment {
+    let mut environment = Environment::default();
+    let hand = match options.affordances {
+        AffordanceSet::Feet => return environment,
+        AffordanceSet::FeetLeftHand => 2,
+        AffordanceSet::FeetRightHand => 3,
+    };
+    let grasps: Vec<Vector3<f64>> = layout
+        .iter()
+        .filter_map(|s| s.targets[hand].map(|t| t.translation.vector))
+        .collect();
+    let lateral_axis = Vector3::z().cross(&frame.forward);
+    let (lateral, height) = if grasps.is_empty() {
+        let side = if hand == 2 { 1.0 } else { -1.0 };
+        (side * 0.35 * frame.scale, 0.9 * frame.scale)
+    } else {
+        let n = grasps.len() as f64;
+        (
+            grasps.iter().map(|g| g.dot(&lateral_axis)).sum::<f64>() / n,
+            grasps.iter().map(|g| g.z).sum::<f64>() / n,
+        )
+    };
+    let at = |along: f64| frame.forward * along + lateral_axis * lateral + Vector3::z() * height;
+    environment.hand_affordances.push(HandAffordance {
+        name: "railing".to_owned(),
+        start: at(-0.5),
+        end: at(options.distance + 0.5),
+        available: options.railing.unwrap_or([0.0, options.distance]),
+    });
+    environment
+}
+
+/// IK of the retargeting: a best effort per stance trading position against rotation errors.
+fn ik_options() -> IkOptions {
+    IkOptions {
+        max_iterations: 60,
+        tolerance: 1e-4,
+        damping: 1e-2,
+        ..IkOptions::default()
+    }
+}
+
+/// The stances and the IK's remaining `[position, orientation]` error of each.
+fn solve(
+    robot: &Robot,
+    layout: &[StanceTargets],
+) -> Result<(Vec<Stance>, Vec<[f64; 2]>), LearnError> {
+    let model = &robot.model;
+    let mut solver = IkSolver::new(model);
+    let options = ik_options();
+    let standing = &robot.standing;
+    let mut current: Configuration = standing.clone();
+    let mut current_root = Vector3::zeros();
+    let mut previous_base = Vector3::zeros();
+    let mut targets = Vec::with_capacity(4);
+    let mut stances = Vec::with_capacity(layout.len());
+    let mut errors = Vec::with_capacity(layout.len());
+    for (i, stance) in layout.iter().enumerate() {
+        targets.clear();
+        for e in EndEffector::ALL {
+            if let Some(pose) = stance.targets[e as usize] {
+                targets.push(IkTarget {
+                    frame: robot.frame(e),
+                    pose,
+                    position_weight: 1.0,
+                    orientation_weight: if e.is_foot() { 1.0 } else { 0.1 },
+                });
+            }
+        }
+        // Warm start: the previous solution carried along with the human root.
+        let mut initial = current.clone();
+        initial.base.translation.vector.x += stance.root.x - current_root.x;
+        initial.base.translation.vector.y += stance.root.y - current_root.y;
+        let solution =
+            match solver.solve(model, &targets, &initial, Some(&standing.joints), &options) {
+                Ok(solution) => solution,
+                Err(IkError::NotConverged(best)) => *best,
+                Err(error) => return Err(LearnError::Retarget(format!("stance {i}: {error}"))),
+            };
+        errors.push([solution.position_error, solution.orientation_error]);
+        current = solution.configuration;
+        current_root = stance.root;
+        let base = current.base.translation.vector;
+        stances.push(Stance {
+            q: current.joints.as_slice().to_vec(),
+            contacts: stance.contacts,
+            translation: base - previous_base,
+            root_orientation: current.base.rotation,
+        });
+        previous_base = base;
+    }
+    Ok((stances, errors))
+}

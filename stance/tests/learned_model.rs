@@ -1,0 +1,311 @@
+//! The n-gram stance model: reproducible training on the vendored corpus (the committed default
+//! model), smoothing, the query, realism against the held-out trial, and retargeting +
+//! post-processing on ARMAR-4 and JVRC-1 for all three affordance sets.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use stance::learned::coverage::covered_distance;
+use stance::learned::realism::{of_generated, of_keyframes};
+use stance::learned::{
+    Demonstration, LearnError, LearnedOptions, NgramModel, Query, Search, SegmentOptions,
+    TrainOptions, generate_learned, generate_tokens, load_folder, segment,
+};
+use stance::{AffordanceSet, PostProcessor};
+
+fn repo(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path)
+}
+
+/// The default training set: the vendored corpus without the held-out gaitkit trial.
+fn training() -> Vec<Demonstration> {
+    ["gaitalytics", "holosoma-climb"]
+        .iter()
+        .flat_map(|f| load_folder(&repo("data/demonstrations").join(f)).unwrap())
+        .collect()
+}
+
+fn model() -> &'static NgramModel {
+    static MODEL: OnceLock<NgramModel> = OnceLock::new();
+    MODEL.get_or_init(|| NgramModel::train(&training(), &TrainOptions::default()).unwrap())
+}
+
+fn walk(distance: f64, search: Search) -> Query {
+    Query {
+        distance,
+        hands: [Vec::new(), Vec::new()],
+        search,
+    }
+}
+
+#[test]
+fn committed_default_model_is_reproducible_from_the_corpus() {
+    let path = repo("data/models/default-ngram.json");
+    let committed = NgramModel::from_path(&path).unwrap();
+    assert_eq!(
+        &committed,
+        model(),
+        "retrain with `walkctl learn` (docs/learning.md)"
+    );
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(text.trim_end(), model().to_json_string());
+}
+
+#[test]
+fn probabilities_are_smoothed_and_sum_to_one() {
+    let model = model();
+    let ids: Vec<u32> = model.token_ids().collect();
+    let contexts = [
+        vec![0],
+        vec![0, ids[0]],
+        vec![ids[3], ids[5]],
+        vec![ids[ids.len() - 1], ids[0]],
+    ];
+    for history in contexts {
+        let p: Vec<f64> = (1..model.vocabulary())
+            .map(|t| model.probability(&history, t))
+            .collect();
+        let total: f64 = p.iter().sum();
+        assert!(
+            (total - 1.0).abs() < 1e-9,
+            "context {history:?}: total {total}"
+        );
+        assert!(
+            p.iter().all(|&v| v > 0.0),
+            "context {history:?}: an unseen token has probability 0"
+        );
+    }
+}
+
+#[test]
+fn beam_search_walks_the_distance_from_and_to_double_support() {
+    let model = model();
+    let generated = generate_tokens(model, &walk(5.0, Search::Beam(8))).unwrap();
+    let first = model.token(generated.tokens[0]).contacts;
+    let last = model.token(*generated.tokens.last().unwrap()).contacts;
+    assert!(first[0] && first[1] && last[0] && last[1]);
+    let reached = *generated.progress.last().unwrap();
+    assert!((5.0..5.6).contains(&reached), "reached {reached} m");
+    assert_eq!(
+        generated,
+        generate_tokens(model, &walk(5.0, Search::Beam(8))).unwrap()
+    );
+    // The most probable sequence is at least as probable as sampled ones.
+    for seed in 0..5 {
+        let sampled = generate_tokens(model, &walk(5.0, Search::Sample(seed))).unwrap();
+        assert!(generated.log_probability >= sampled.log_probability - 1e-9);
+    }
+}
+
+#[test]
+fn sampling_is_seeded() {
+    let model = model();
+    let a = generate_tokens(model, &walk(8.0, Search::Sample(1))).unwrap();
+    assert_eq!(
+        a,
+        generate_tokens(model, &walk(8.0, Search::Sample(1))).unwrap()
+    );
+    let differs = (2..12).any(|seed| {
+        generate_tokens(model, &walk(8.0, Search::Sample(seed)))
+            .unwrap()
+            .tokens
+            != a.tokens
+    });
+    assert!(differs, "ten seeds gave the same sequence");
+}
+
+#[test]
+fn hands_are_used_only_where_available() {
+    let model = model();
+    for seed in 0..20 {
+        let generated = generate_tokens(model, &walk(4.0, Search::Sample(seed))).unwrap();
+        assert!(generated.hands.iter().all(|h| !h[0] && !h[1]));
+    }
+    // With the left hand available on [1, 3] m, a left-hand stance may appear only there.
+    for seed in 0..20 {
+        let query = Query {
+            distance: 4.0,
+            hands: [vec![[1.0, 3.0]], Vec::new()],
+            search: Search::Sample(seed),
+        };
+        let generated = generate_tokens(model, &query).unwrap();
+        for (hands, &at) in generated.hands.iter().zip(&generated.progress) {
+            assert!(!hands[1] && (!hands[0] || (1.0..=3.0).contains(&at)));
+        }
+    }
+    // With a railing along the whole path, the hand-support model adds grasps of that hand.
+    let mut grasps = 0;
+    let mut stances = 0;
+    for seed in 0..20 {
+        let query = Query {
+            distance: 4.0,
+            hands: [Vec::new(), vec![[0.0, 4.0]]],
+            search: Search::Sample(seed),
+        };
+        let generated = generate_tokens(model, &query).unwrap();
+        assert!(generated.hands.iter().all(|h| !h[0]));
+        grasps += generated.hands.iter().filter(|h| h[1]).count();
+        stances += generated.hands.len();
+    }
+    println!("right-hand railing: {grasps} grasping stances of {stances}");
+    assert!(
+        grasps * 20 >= stances,
+        "{grasps} grasping stances of {stances}"
+    );
+    let error = generate_tokens(model, &walk(-1.0, Search::Beam(4))).unwrap_err();
+    assert!(matches!(error, LearnError::Query(_)), "{error}");
+}
+
+#[test]
+fn generated_walks_resemble_the_held_out_trial() {
+    let model = model();
+    let held_out = load_folder(&repo("data/demonstrations/gaitkit")).unwrap();
+    let reference = of_keyframes(&segment(&held_out[0], &SegmentOptions::default()).keyframes);
+    let generated = of_generated(
+        model,
+        &generate_tokens(model, &walk(10.0, Search::Beam(8))).unwrap(),
+    );
+    println!("held-out  {reference:#?}\ngenerated {generated:#?}");
+    let ratio = generated.step_length.mean / reference.step_length.mean;
+    assert!((0.8..1.25).contains(&ratio), "step length ratio {ratio}");
+    let ratio = generated.stance_duration.p50 / reference.stance_duration.p50;
+    assert!(
+        (0.67..1.5).contains(&ratio),
+        "median stance duration ratio {ratio}"
+    );
+    // Step width differs with the marker sets (sole midpoints of heel/MT2 vs heel/toe landmarks):
+    // only require a human range.
+    assert!((0.03..0.35).contains(&generated.step_width.mean));
+}
+
+#[test]
+fn retargeted_sequences_post_process_on_both_robots_for_all_affordance_sets() {
+    let model = model();
+    for (robot, params) in [common::armar4(), common::jvrc1()] {
+        let mut processor = PostProcessor::new(robot, params.clone());
+        for affordances in AffordanceSet::ALL {
+            let requested = 1.5;
+            let mut grasps = 0;
+            for search in [
+                Search::Beam(8),
+                Search::Sample(0),
+                Search::Sample(1),
+                Search::Sample(2),
+            ] {
+                let options = LearnedOptions {
+                    distance: requested / params.scf,
+                    affordances,
+                    railing: None,
+                    search,
+                };
+                let retargeted = generate_learned(robot, model, &options).unwrap();
+                let (raw, generated) = (&retargeted.raw, &retargeted.generated);
+                let errors = &retargeted.ik_errors;
+                let mean = errors.iter().map(|e| e[0]).sum::<f64>() / errors.len() as f64;
+                let worst = errors
+                    .iter()
+                    .fold([0.0f64; 2], |w, e| [w[0].max(e[0]), w[1].max(e[1])]);
+                println!(
+                    "{} {affordances} {search:?}: IK error mean {mean:.1e} m, max {:.1e} m, {:.1e} rad",
+                    robot.name, worst[0], worst[1]
+                );
+                assert!(
+                    worst[0] < 0.01 && worst[1] < 0.05,
+                    "{} {affordances}: IK error {worst:?}",
+                    robot.name
+                );
+                assert_eq!(raw.len(), generated.tokens.len());
+                raw.check_robot(robot).unwrap();
+                grasps += raw
+                    .stances()
+                    .iter()
+                    .filter(|s| s.contacts[2] || s.contacts[3])
+                    .count();
+                let post = processor
+                    .process(raw)
+                    .unwrap_or_else(|e| panic!("{} {affordances} {search:?}: {e}", robot.name));
+                let covered = covered_distance(&post);
+                assert!(
+                    (covered - requested).abs() < 0.25 * requested,
+                    "{} {affordances} {search:?}: covered {covered} m of {requested} m",
+                    robot.name
+                );
+                assert_eq!(
+                    !raw.environment().hand_affordances.is_empty(),
+                    affordances != AffordanceSet::Feet
+                );
+            }
+            println!(
+                "{} {affordances}: {grasps} stances with a hand in 4 sequences",
+                robot.name
+            );
+            assert_eq!(
+                grasps == 0,
+                affordances == AffordanceSet::Feet,
+                "{} {affordances}",
+                robot.name
+            );
+        }
+    }
+}
+
+#[test]
+fn retargeted_sequences_keep_the_natural_impediments() {
+    use kinematics::robot::EndEffector;
+    use stance::derived::jumping_contacts;
+    use stance::geometry::roll_pitch_yaw;
+    let (robot, params) = common::armar4();
+    let options = LearnedOptions {
+        distance: 4.0 / params.scf,
+        affordances: AffordanceSet::FeetLeftHand,
+        railing: None,
+        search: Search::Sample(0),
+    };
+    let raw = generate_learned(robot, model(), &options).unwrap().raw;
+    let mut processor = PostProcessor::new(robot, params.clone());
+    let poses = processor.forward_kinematics(&raw).unwrap().clone();
+    let jumps: usize = [EndEffector::LeftFoot, EndEffector::RightFoot]
+        .iter()
+        .map(|&foot| jumping_contacts(&poses, foot, 1e-3).len())
+        .sum();
+    let tilted = (0..poses.len())
+        .flat_map(|i| [EndEffector::LeftFoot, EndEffector::RightFoot].map(|f| (i, f)))
+        .filter(|&(i, f)| poses.in_contact(i, f))
+        .filter(|&(i, f)| {
+            let [roll, pitch, _] = roll_pitch_yaw(&poses.pose(i, f).rotation);
+            roll.abs().max(pitch.abs()) > 0.02
+        })
+        .count();
+    println!(
+        "{} stances: {jumps} jumping foot contacts, {tilted} tilted contact soles",
+        poses.len()
+    );
+    assert!(jumps > 0 && tilted > 0);
+    // … and post-processing removes them.
+    let post = processor.process(&raw).unwrap();
+    for i in 0..post.len() {
+        for f in [EndEffector::LeftFoot, EndEffector::RightFoot] {
+            if post.contacts(i)[f as usize] {
+                let [roll, pitch, _] = roll_pitch_yaw(&post.target(i, f).rotation);
+                assert!(roll.abs() < 1e-9 && pitch.abs() < 1e-9, "stance {i} {f:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn bad_model_files_are_refused() {
+    let text = model().to_json_string();
+    let path = Path::new("model.json");
+    let broken = text.replacen("\"version\": 1", "\"version\": 9", 1);
+    let error = NgramModel::from_json_str(&broken, path)
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("version 9"), "{error}");
+    let error = NgramModel::from_json_str(&text[..text.len() / 2], path)
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("model.json"), "{error}");
+}
