@@ -1,1 +1,18 @@
-//! `walkctl` as a library: the operations on stance sequences and on a running `walkd`.
+//! `walkctl` as a library: the operations on robot models, stance sequences and a running `walkd`.
+//!
+//! One module per subcommand; each exposes its `clap::Args` struct and a `run` function so the
+//! binary only dispatches and programs can call the same operations.
+
+pub mod bench_coverage;
+pub mod bench_postprocess;
+pub mod control;
+pub mod daemon_client;
+pub mod demo;
+pub mod evaluate;
+pub mod generate;
+pub mod inspect;
+pub mod learn;
+pub mod postprocess;
+pub mod status;
+pub mod submit;
+pub mod watch;

@@ -1,7 +1,7 @@
 //! `walk-sim`: a simulated robot process behind the adapter side of the walkd IPC contract.
 //!
 //! ```text
-//! walk-sim --config configs/armar4.toml --physics kinematic [--clock realtime|lockstep]
+//! walk-sim --config configs/armar4.toml --physics kinematic|mujoco [--clock realtime|lockstep]
 //!          [--rate-hz F] [--urdf PATH] [--service-prefix P]
 //! ```
 //! Exit codes: see `shm_types::process::exit_code` (0 clean, 3 config/model, 4 IPC, 1 other).
@@ -12,10 +12,11 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use clap::{Parser, ValueEnum};
+use kinematic_sim::SafetySummary;
 use kinematics::robot::Robot;
 use shm_types::process::{exit_code, install_termination_handler, termination_requested};
 use shm_types::{AdapterPorts, ClockMode, RuntimeConfig, ServiceNames};
-use sim_adapter::{AdapterOptions, KinematicRobot, run_adapter};
+use sim_adapter::{AdapterOptions, KinematicRobot, RobotIo, run_adapter};
 
 /// Simulated robot for walkd: publishes sensor samples, applies joint commands.
 #[derive(Parser)]
@@ -46,6 +47,8 @@ struct Args {
 enum Physics {
     /// Deterministic kinematic simulator (ideal servos, feet anchored in contact).
     Kinematic,
+    /// MuJoCo rigid-body dynamics with contacts (needs --features sim-adapter/mujoco).
+    Mujoco,
 }
 
 fn main() -> ExitCode {
@@ -85,29 +88,76 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
     }
     let robot =
         Robot::load(&args.config, args.urdf.as_deref()).map_err(|e| config_error(e.into()))?;
-    let mut sim = match args.physics {
-        Physics::Kinematic => KinematicRobot::standing(Arc::new(robot))
-            .map_err(|e| config_error(anyhow::Error::from(e).context("standing posture")))?,
-    };
+    let robot = Arc::new(robot);
+    match args.physics {
+        Physics::Kinematic => {
+            let mut sim = KinematicRobot::standing(robot)
+                .map_err(|e| config_error(anyhow::Error::from(e).context("standing posture")))?;
+            serve(&runtime, args.clock, &mut sim, |sim| *sim.summary())
+        }
+        Physics::Mujoco => serve_mujoco(robot, &runtime, args.clock),
+    }
+}
+
+/// `--physics mujoco`: the robot standing in its configured posture under MuJoCo.
+#[cfg(feature = "mujoco")]
+fn serve_mujoco(
+    robot: Arc<Robot>,
+    runtime: &RuntimeConfig,
+    clock: ClockMode,
+) -> Result<(), (u8, anyhow::Error)> {
+    use sim_adapter::mujoco::{MujocoOptions, MujocoRobot};
+    let urdf = robot.urdf.clone();
+    let mut sim = MujocoRobot::standing(robot, &urdf, MujocoOptions::default()).map_err(|e| {
+        (
+            exit_code::CONFIG,
+            anyhow::Error::from(e).context("MuJoCo model"),
+        )
+    })?;
+    serve(runtime, clock, &mut sim, |sim| *sim.summary())
+}
+
+/// `--physics mujoco` in a build without the backend: says how to get it.
+#[cfg(not(feature = "mujoco"))]
+fn serve_mujoco(
+    _robot: Arc<Robot>,
+    _runtime: &RuntimeConfig,
+    _clock: ClockMode,
+) -> Result<(), (u8, anyhow::Error)> {
+    Err((
+        exit_code::CONFIG,
+        anyhow::anyhow!(
+            "built without MuJoCo: run scripts/setup-mujoco.sh and build with --features sim-adapter/mujoco"
+        ),
+    ))
+}
+
+/// Runs the adapter loop for `sim` until terminated; logs the simulator's safety summary.
+fn serve<R: RobotIo>(
+    runtime: &RuntimeConfig,
+    clock: ClockMode,
+    sim: &mut R,
+    summary: impl Fn(&R) -> SafetySummary,
+) -> Result<(), (u8, anyhow::Error)> {
     let names =
         ServiceNames::new(&runtime.service_prefix).map_err(|e| (exit_code::IPC, e.into()))?;
     let ports = AdapterPorts::open(&names, "walk-sim").map_err(|e| (exit_code::IPC, e.into()))?;
     install_termination_handler();
     let options = AdapterOptions {
-        clock: args.clock,
+        clock,
         rate_hz: runtime.rate_hz,
         watchdog_periods: runtime.watchdog_periods,
         lockstep_timeout: Duration::from_millis(runtime.lockstep_timeout_ms),
     };
     tracing::info!(
         prefix = names.prefix(),
-        clock = args.clock.name(),
+        clock = clock.name(),
         rate_hz = runtime.rate_hz,
         "walk-sim running"
     );
-    let report = run_adapter(&ports, &mut sim, &options, &termination_requested)
+    let report = run_adapter(&ports, sim, &options, &termination_requested)
         .map_err(|e| (exit_code::IPC, e.into()))?;
-    let safety = sim.summary();
+    let safety = summary(sim);
     tracing::info!(
         samples = report.samples,
         commands = report.commands,

@@ -1,0 +1,396 @@
+//! The controller walking under rigid-body physics, in one process: `daemon::controller` in
+//! closed loop with `sim_adapter::mujoco::MujocoSim` (feature `mujoco`).
+//!
+//! Each control tick the controller reads the simulator's joint encoders, foot FT wrenches and
+//! IMU orientation, and the simulator advances one control period (two 1 ms physics steps at
+//! 500 Hz) with the servos tracking the command. A walk succeeds when the controller reaches
+//! `Done` and the simulated robot never fell (base height and torso tilt,
+//! [`MujocoSim::has_fallen`]) — neither during the walk nor while holding the final posture for
+//! [`PhysicsWalkOptions::settle_s`] afterwards.
+//!
+//! Besides the outcome it measures what the paper's evaluation reports: simulated and wall time,
+//! the final position error of the feet, the drift between the controller's estimate and the
+//! simulator's truth (CoM and soles), and a time trace of target vs controller vs simulator for
+//! the paper's Fig. 6.
+
+use std::path::Path;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use client::evaluate::{Points, TraceSample, align_targets, stance_points};
+use daemon::controller::{
+    Command, Controller, ControllerConfig, ControllerState, ControllerStatus, FaultCode,
+    Measurement, SolverKind,
+};
+use kinematics::robot::{EndEffector, Robot};
+use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim};
+use stance::{
+    AffordanceSet, GenerateOptions, PostProcessParams, PostProcessedSequence, PostProcessor,
+};
+
+/// How to run a physics walk.
+#[derive(Clone, Copy, Debug)]
+pub struct PhysicsWalkOptions {
+    /// QP back-end of the controller.
+    pub solver: SolverKind,
+    /// Control rate (Hz); the simulator advances by its period each tick.
+    pub rate_hz: f64,
+    /// Simulated time after which an unfinished walk is stopped; `None`: 60 s + 20 s per stance
+    /// (as `walkd bench`).
+    pub time_limit_s: Option<f64>,
+    /// Simulated time the final posture is held after `Done` while still checking for a fall (s).
+    pub settle_s: f64,
+    /// Every this many ticks one [`TraceSample`] is recorded (0: no trace).
+    pub trace_every: u64,
+    /// The physics model (default: [`stiff_servos`]).
+    pub mujoco: MujocoOptions,
+}
+
+impl Default for PhysicsWalkOptions {
+    fn default() -> Self {
+        Self {
+            solver: SolverKind::Dense,
+            rate_hz: 500.0,
+            time_limit_s: None,
+            settle_s: 1.0,
+            trace_every: 10,
+            mujoco: stiff_servos(),
+        }
+    }
+}
+
+/// The physics model of the walks: stiffer joint servos than `MujocoOptions::default()`
+/// (kp 1e5 N·m/rad, kv 1000 N·m·s/rad) with the rotor inertia of geared joints (armature
+/// 0.2 kg·m², which keeps kp·h²/armature at 0.5 for 1 ms steps). With the default servos the
+/// stance leg's joints yield under the robot's weight fast enough that the controller's
+/// proportional tasks settle millimetres off their targets (a lifted foot 7.5 mm off its goal).
+pub fn stiff_servos() -> MujocoOptions {
+    MujocoOptions {
+        servo_stiffness: 1e5,
+        servo_damping: 1000.0,
+        armature: 0.2,
+        ..MujocoOptions::default()
+    }
+}
+
+/// How a physics walk ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PhysicsOutcome {
+    /// `Done`, and the robot stood through the settle time.
+    Done,
+    /// The simulated robot fell (base too low or torso tilted) at this simulated time (s).
+    Fell {
+        /// Simulated time of the fall (s).
+        at_s: f64,
+    },
+    /// The controller faulted.
+    Fault(FaultCode),
+    /// The simulated time limit passed before `Done`.
+    TimeLimit,
+    /// MuJoCo found the state diverged at this simulated time (s).
+    Unstable {
+        /// Simulated time of the divergence (s).
+        at_s: f64,
+    },
+}
+
+impl PhysicsOutcome {
+    /// `done`, `fell`, `fault:<code>`, `time_limit` or `unstable`.
+    pub fn label(&self) -> String {
+        match self {
+            Self::Done => "done".to_owned(),
+            Self::Fell { .. } => "fell".to_owned(),
+            Self::Fault(code) => format!("fault:{}", code.code()),
+            Self::TimeLimit => "time_limit".to_owned(),
+            Self::Unstable { .. } => "unstable".to_owned(),
+        }
+    }
+}
+
+/// Everything measured in one physics walk.
+#[derive(Clone, Debug)]
+pub struct PhysicsWalkReport {
+    /// How it ended.
+    pub outcome: PhysicsOutcome,
+    /// Stances in the sequence.
+    pub stances: usize,
+    /// The stance the controller was moving towards at the end.
+    pub stance_reached: u32,
+    /// Control ticks until the outcome (settle time excluded).
+    pub ticks: u64,
+    /// Simulated time until the outcome (s, settle time excluded).
+    pub sim_s: f64,
+    /// Wall time of the whole closed loop, settle time included (s).
+    pub wall_s: f64,
+    /// Wall time spent in `Controller::tick` (s).
+    pub controller_s: f64,
+    /// Wall time spent in `MujocoSim::step` (s).
+    pub physics_s: f64,
+    /// Simulated time including the settle time (s), for the real-time factor.
+    pub total_sim_s: f64,
+    /// Largest distance of a simulated sole from its final-stance target at the end (m); the
+    /// targets are placed on the standing feet as the controller places them.
+    pub final_position_error_m: f64,
+    /// Largest controller-vs-simulator CoM distance over the walk (m).
+    pub max_com_drift_m: f64,
+    /// Largest controller-vs-simulator sole distance over the walk (m).
+    pub max_foot_drift_m: f64,
+    /// Controller-vs-simulator CoM and sole distances at the end (m).
+    pub final_drift_m: (f64, f64),
+    /// Horizontal distance the simulated feet midpoint travelled (m).
+    pub distance_m: f64,
+    /// Largest horizontal slip of a foot in contact since its touchdown (m).
+    pub max_contact_slip_m: f64,
+    /// Smallest static stability margin of the simulated CoM over the ticks with a foot on the
+    /// floor (m; negative = outside the support polygon).
+    pub min_stability_margin_m: f64,
+    /// Largest tilt of the base link from vertical seen (rad).
+    pub max_tilt_rad: f64,
+    /// Lowest base-link height over its initial height.
+    pub min_base_height_ratio: f64,
+    /// The Fig. 6 trace (every [`PhysicsWalkOptions::trace_every`] ticks), with the simulator's
+    /// truth; draw it with `client::evaluate::write_fig6`.
+    pub trace: Vec<TraceSample>,
+}
+
+impl PhysicsWalkReport {
+    /// Reached `Done` without a fall.
+    pub fn success(&self) -> bool {
+        self.outcome == PhysicsOutcome::Done
+    }
+
+    /// The drift reported per run: the larger of the CoM and sole drifts over the walk (m).
+    pub fn drift_m(&self) -> f64 {
+        self.max_com_drift_m.max(self.max_foot_drift_m)
+    }
+
+    /// Simulated time over wall time of the whole loop.
+    pub fn real_time_factor(&self) -> f64 {
+        self.total_sim_s / self.wall_s
+    }
+}
+
+/// Generates a forward walk of `distance` metres for the robot of `config` (seeded), post-
+/// processes it with the config's `[postprocess]` section and walks it under physics.
+pub fn walk_distance(
+    config: &Path,
+    urdf: Option<&Path>,
+    distance: f64,
+    affordances: AffordanceSet,
+    seed: u64,
+    options: &PhysicsWalkOptions,
+) -> anyhow::Result<PhysicsWalkReport> {
+    let robot = Arc::new(
+        Robot::load(config, urdf).with_context(|| format!("loading {}", config.display()))?,
+    );
+    let params = PostProcessParams::from_config_path(config)?;
+    let controller_config = ControllerConfig::from_config_file(config)?;
+    let raw = stance::generate(
+        &robot,
+        &GenerateOptions {
+            distance: distance / params.scf,
+            affordances,
+            seed,
+        },
+    )
+    .context("generating the stance sequence")?;
+    let sequence = PostProcessor::new(&robot, params)
+        .process(&raw)
+        .context("post-processing the stance sequence")?;
+    walk_sequence(robot, controller_config, &sequence, options)
+}
+
+/// Executes `sequence` on `robot`, starting from its standing posture, in closed loop with MuJoCo.
+pub fn walk_sequence(
+    robot: Arc<Robot>,
+    config: ControllerConfig,
+    sequence: &PostProcessedSequence,
+    options: &PhysicsWalkOptions,
+) -> anyhow::Result<PhysicsWalkReport> {
+    anyhow::ensure!(
+        options.rate_hz.is_finite() && options.rate_hz > 0.0,
+        "rate {} Hz: must be a positive number",
+        options.rate_hz
+    );
+    let prepared = Controller::prepare(&robot, &config, sequence)
+        .map_err(|refusal| anyhow::anyhow!("the controller refused the sequence: {refusal}"))?;
+    let mut targets = stance_points(&robot, sequence);
+    let mut controller = Controller::new(robot.clone(), config, options.solver)?;
+    let mut sim = MujocoSim::new(robot.clone(), &robot.urdf, &robot.standing, options.mujoco)
+        .context("building the MuJoCo model")?;
+    if controller.start(Box::new(prepared)).is_err() {
+        anyhow::bail!("a new controller refused to start");
+    }
+    let dt = 1.0 / options.rate_hz;
+    let time_limit = options
+        .time_limit_s
+        .unwrap_or(60.0 + 20.0 * sequence.len() as f64);
+    let max_ticks = (time_limit * options.rate_hz).ceil() as u64;
+    let settle_ticks = (options.settle_s * options.rate_hz).ceil() as u64;
+    let mut command = Command::new(robot.model.dof());
+    let start_midpoint = feet_midpoint(&sim);
+    align_targets(&mut targets, &sim_points(&sim));
+    let initial_height = sim.base_height();
+    let mut loop_state = LoopState {
+        trace: Vec::with_capacity((max_ticks / options.trace_every.max(1)).min(1 << 20) as usize),
+        max_com_drift: 0.0,
+        max_foot_drift: 0.0,
+        max_tilt: 0.0,
+        min_height: initial_height,
+        min_margin: f64::INFINITY,
+        controller_time: Duration::ZERO,
+        physics_time: Duration::ZERO,
+    };
+    let wall = Instant::now();
+    let mut ticks = 0u64;
+    let mut outcome = loop {
+        if ticks >= max_ticks {
+            break PhysicsOutcome::TimeLimit;
+        }
+        if let Err(outcome) = loop_state.tick(&mut controller, &mut sim, &mut command, dt) {
+            break outcome;
+        }
+        ticks += 1;
+        let status = controller.status();
+        loop_state.observe(&sim, status);
+        if options.trace_every > 0 && ticks % options.trace_every == 0 {
+            let sample = TraceSample {
+                t: sim.time(),
+                stance_index: status.stance_index,
+                target: targets[(status.stance_index as usize).min(targets.len() - 1)],
+                controller: controller_points(status),
+                sim: Some(sim_points(&sim)),
+            };
+            loop_state.trace.push(sample);
+        }
+        if sim.has_fallen() {
+            break PhysicsOutcome::Fell { at_s: sim.time() };
+        }
+        match status.state {
+            ControllerState::Done => break PhysicsOutcome::Done,
+            ControllerState::Fault => break PhysicsOutcome::Fault(status.fault),
+            _ => {}
+        }
+    };
+    let sim_s = sim.time();
+    let end_drift = sim_points(&sim).distances(&controller_points(controller.status()));
+    if outcome == PhysicsOutcome::Done {
+        for _ in 0..settle_ticks {
+            if let Err(o) = loop_state.tick(&mut controller, &mut sim, &mut command, dt) {
+                outcome = o;
+                break;
+            }
+            loop_state.observe(&sim, controller.status());
+            if sim.has_fallen() {
+                outcome = PhysicsOutcome::Fell { at_s: sim.time() };
+                break;
+            }
+        }
+    }
+    let wall_s = wall.elapsed().as_secs_f64();
+    let last = targets[targets.len() - 1];
+    let end = sim_points(&sim);
+    let final_position_error_m = end.distances(&last).1;
+    let summary = sim.summary();
+    Ok(PhysicsWalkReport {
+        outcome,
+        stances: sequence.len(),
+        stance_reached: controller.status().stance_index,
+        ticks,
+        sim_s,
+        wall_s,
+        controller_s: loop_state.controller_time.as_secs_f64(),
+        physics_s: loop_state.physics_time.as_secs_f64(),
+        total_sim_s: sim.time(),
+        final_position_error_m,
+        max_com_drift_m: loop_state.max_com_drift,
+        max_foot_drift_m: loop_state.max_foot_drift,
+        final_drift_m: end_drift,
+        distance_m: (feet_midpoint(&sim) - start_midpoint).norm(),
+        max_contact_slip_m: summary.max_contact_slip,
+        min_stability_margin_m: loop_state.min_margin,
+        max_tilt_rad: loop_state.max_tilt,
+        min_base_height_ratio: loop_state.min_height / initial_height,
+        trace: loop_state.trace,
+    })
+}
+
+/// What the closed loop accumulates while it runs.
+struct LoopState {
+    trace: Vec<TraceSample>,
+    max_com_drift: f64,
+    max_foot_drift: f64,
+    max_tilt: f64,
+    min_height: f64,
+    min_margin: f64,
+    controller_time: Duration,
+    physics_time: Duration,
+}
+
+impl LoopState {
+    /// One control tick: measure, control, step the physics by `dt`.
+    fn tick(
+        &mut self,
+        controller: &mut Controller,
+        sim: &mut MujocoSim,
+        command: &mut Command,
+        dt: f64,
+    ) -> Result<(), PhysicsOutcome> {
+        let m = sim.measurement();
+        let measurement = Measurement {
+            q: m.q.as_slice(),
+            qd: m.qd.as_slice(),
+            wrenches: &m.wrenches,
+            imu_orientation: Some(m.base_orientation),
+        };
+        let started = Instant::now();
+        controller.tick(&measurement, dt, command);
+        let stepped = Instant::now();
+        let result = sim.step(command.q_des.as_slice(), command.qd_des.as_slice(), dt);
+        self.physics_time += stepped.elapsed();
+        self.controller_time += stepped - started;
+        match result {
+            Ok(()) => Ok(()),
+            Err(MujocoError::Unstable { time }) => Err(PhysicsOutcome::Unstable { at_s: time }),
+            // Commands are always finite, in-limit and sized by the controller's contract.
+            Err(error) => panic!("the simulator refused a controller command: {error}"),
+        }
+    }
+
+    /// Drift and fall indicators of the state after a tick.
+    fn observe(&mut self, sim: &MujocoSim, status: &ControllerStatus) {
+        let (com, feet) = sim_points(sim).distances(&controller_points(status));
+        self.max_com_drift = self.max_com_drift.max(com);
+        self.max_foot_drift = self.max_foot_drift.max(feet);
+        self.max_tilt = self.max_tilt.max(sim.torso_tilt());
+        self.min_height = self.min_height.min(sim.base_height());
+        let m = sim.measurement();
+        if m.contacts.iter().any(|&c| c) {
+            self.min_margin = self.min_margin.min(m.safety.stability_margin);
+        }
+    }
+}
+
+fn controller_points(status: &ControllerStatus) -> Points {
+    Points::from_status(&status.com, &status.left_foot, &status.right_foot)
+}
+
+fn sim_points(sim: &MujocoSim) -> Points {
+    Points {
+        com: sim.measurement().com,
+        left_foot: sim
+            .end_effector_pose(EndEffector::LeftFoot)
+            .translation
+            .vector,
+        right_foot: sim
+            .end_effector_pose(EndEffector::RightFoot)
+            .translation
+            .vector,
+    }
+}
+
+fn feet_midpoint(sim: &MujocoSim) -> nalgebra::Vector2<f64> {
+    let p = sim_points(sim);
+    (p.left_foot.xy() + p.right_foot.xy()) / 2.0
+}
