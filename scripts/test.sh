@@ -1,11 +1,17 @@
 #!/usr/bin/env bash
-# The project's test command (README): builds everything it needs, then runs every test.
+# The project's test command (README): sets up, builds everything it needs, runs every test.
 #
-# The end-to-end tests start the real `walkd`, `walk-sim` and `walkctl` processes, which live in
+# Set-up: the pinned MuJoCo library for the physics back-end (scripts/setup-mujoco.sh). The
+# end-to-end tests start the real `walkd`, `walk-sim` and `walkctl` processes, which live in
 # other packages than the tests, so the binaries are built first. Everything is built with
-# `--release` so one build of the dependency set serves the demo, the tests and the benchmarks.
+# `--release` and the same features, so one build of the dependency set serves the demo, the
+# tests and the benchmarks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-cargo build --release --workspace --bins
-cargo test --release --workspace "$@"
+mujoco_env="$(scripts/setup-mujoco.sh)"
+eval "$mujoco_env"
+
+cargo build --release --workspace --bins --features sim-adapter/mujoco
+# walk-tests/mujoco: the in-process physics walk (tests/physics_walk.rs fails if it is off).
+cargo test --release --workspace --features sim-adapter/mujoco,walk-tests/mujoco "$@"
