@@ -26,6 +26,7 @@ mod pipeline;
 pub mod plot;
 pub mod poses;
 pub mod sequence;
+mod stance_ik;
 
 pub use environment::{Environment, HandAffordance, SupportSurface};
 pub use error::{FormatError, Location};

@@ -10,7 +10,7 @@ mod impediments;
 use std::fmt;
 use std::str::FromStr;
 
-use kinematics::ik::{IkError, IkOptions, IkSolver, IkTarget};
+use kinematics::ik::IkError;
 use kinematics::robot::{EndEffector, Robot};
 use kinematics::{Configuration, Kinematics};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
@@ -21,6 +21,7 @@ use crate::environment::{Environment, HandAffordance};
 use crate::error::FormatError;
 use crate::geometry::yaw;
 use crate::sequence::{RawSequence, Stance};
+use crate::stance_ik::StanceIk;
 use gait::{Body, PlannedStance, Railing};
 
 /// Pelvis height of the human the statistics describe (metres); the robot's pelvis height over
@@ -195,17 +196,6 @@ fn measure(robot: &Robot) -> Body {
     }
 }
 
-/// IK settings of the retargeting: a best effort per stance, as a human-to-robot mapping that
-/// trades position against rotation errors (an unreachable target yields the closest pose).
-fn ik_options() -> IkOptions {
-    IkOptions {
-        max_iterations: 60,
-        tolerance: 1e-4,
-        damping: 1e-2,
-        ..IkOptions::default()
-    }
-}
-
 /// Solves every planned stance with the robot's IK, warm-started from the previous stance, and
 /// expresses the root as eq. 1's translation from the previous stance.
 fn retarget(
@@ -213,43 +203,15 @@ fn retarget(
     body: &Body,
     plan: &[PlannedStance],
 ) -> Result<Vec<Stance>, GenerateError> {
-    let model = &robot.model;
-    let mut solver = IkSolver::new(model);
-    let options = ik_options();
-    let standing = &robot.standing;
-    let mut current: Configuration = standing.clone();
-    let mut previous_root = Vector3::zeros();
-    let mut targets = Vec::with_capacity(4);
+    let mut ik = StanceIk::new(robot);
     let mut stances = Vec::with_capacity(plan.len());
     for (i, planned) in plan.iter().enumerate() {
-        targets.clear();
-        for e in EndEffector::ALL {
-            if let Some(pose) = planned.targets[e as usize] {
-                targets.push(IkTarget {
-                    frame: robot.frame(e),
-                    pose,
-                    position_weight: 1.0,
-                    orientation_weight: if e.is_foot() { 1.0 } else { 0.1 },
-                });
-            }
-        }
-        let mut initial = current.clone();
-        initial.base = initial_base(standing, body, planned);
-        let solution =
-            match solver.solve(model, &targets, &initial, Some(&standing.joints), &options) {
-                Ok(solution) => solution,
-                Err(IkError::NotConverged(best)) => *best,
-                Err(source) => return Err(GenerateError::Ik { stance: i, source }),
-            };
-        current = solution.configuration;
-        let root = current.base.translation.vector;
-        stances.push(Stance {
-            q: current.joints.as_slice().to_vec(),
-            contacts: planned.contacts,
-            translation: root - previous_root,
-            root_orientation: current.base.rotation,
-        });
-        previous_root = root;
+        let mut initial = ik.current().clone();
+        initial.base = initial_base(&robot.standing, body, planned);
+        let solved = ik
+            .solve(&planned.targets, planned.contacts, &initial)
+            .map_err(|source| GenerateError::Ik { stance: i, source })?;
+        stances.push(solved.stance);
     }
     Ok(stances)
 }

@@ -5,9 +5,8 @@
 //! pose. Nothing is cleaned up: the raw sequence keeps the demonstrations' natural impediments
 //! (jumping contacts, toe-out, pitched soles, uneven steps) for post-processing to remove.
 
-use kinematics::ik::{IkError, IkOptions, IkSolver, IkTarget};
+use kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
-use kinematics::{Configuration, Kinematics};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use super::error::LearnError;
@@ -16,6 +15,7 @@ use super::query::{Generated, Query, Search, generate_tokens};
 use crate::environment::{Environment, HandAffordance};
 use crate::generate::AffordanceSet;
 use crate::sequence::{RawSequence, Stance};
+use crate::stance_ik::StanceIk;
 
 /// What to generate with a learned model.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -222,64 +222,26 @@ fn environment(
     environment
 }
 
-/// IK of the retargeting: a best effort per stance trading position against rotation errors.
-fn ik_options() -> IkOptions {
-    IkOptions {
-        max_iterations: 60,
-        tolerance: 1e-4,
-        damping: 1e-2,
-        ..IkOptions::default()
-    }
-}
-
 /// The stances and the IK's remaining `[position, orientation]` error of each.
 fn solve(
     robot: &Robot,
     layout: &[StanceTargets],
 ) -> Result<(Vec<Stance>, Vec<[f64; 2]>), LearnError> {
-    let model = &robot.model;
-    let mut solver = IkSolver::new(model);
-    let options = ik_options();
-    let standing = &robot.standing;
-    let mut current: Configuration = standing.clone();
+    let mut ik = StanceIk::new(robot);
     let mut current_root = Vector3::zeros();
-    let mut previous_base = Vector3::zeros();
-    let mut targets = Vec::with_capacity(4);
     let mut stances = Vec::with_capacity(layout.len());
     let mut errors = Vec::with_capacity(layout.len());
     for (i, stance) in layout.iter().enumerate() {
-        targets.clear();
-        for e in EndEffector::ALL {
-            if let Some(pose) = stance.targets[e as usize] {
-                targets.push(IkTarget {
-                    frame: robot.frame(e),
-                    pose,
-                    position_weight: 1.0,
-                    orientation_weight: if e.is_foot() { 1.0 } else { 0.1 },
-                });
-            }
-        }
         // Warm start: the previous solution carried along with the human root.
-        let mut initial = current.clone();
+        let mut initial = ik.current().clone();
         initial.base.translation.vector.x += stance.root.x - current_root.x;
         initial.base.translation.vector.y += stance.root.y - current_root.y;
-        let solution =
-            match solver.solve(model, &targets, &initial, Some(&standing.joints), &options) {
-                Ok(solution) => solution,
-                Err(IkError::NotConverged(best)) => *best,
-                Err(error) => return Err(LearnError::Retarget(format!("stance {i}: {error}"))),
-            };
-        errors.push([solution.position_error, solution.orientation_error]);
-        current = solution.configuration;
+        let solved = ik
+            .solve(&stance.targets, stance.contacts, &initial)
+            .map_err(|error| LearnError::Retarget(format!("stance {i}: {error}")))?;
+        errors.push(solved.errors);
+        stances.push(solved.stance);
         current_root = stance.root;
-        let base = current.base.translation.vector;
-        stances.push(Stance {
-            q: current.joints.as_slice().to_vec(),
-            contacts: stance.contacts,
-            translation: base - previous_base,
-            root_orientation: current.base.rotation,
-        });
-        previous_base = base;
     }
     Ok((stances, errors))
 }
