@@ -93,6 +93,79 @@ pub enum SimError {
     BadTimeStep(f64),
 }
 
+/// Why a joint vector handed to a simulator (a command, an initial posture) is unusable; every
+/// simulator back-end reports it through its own error type.
+#[derive(Debug, Clone, PartialEq)]
+pub enum JointVectorError {
+    /// Not one entry per model joint.
+    Length {
+        /// Which vector (`q_des`, `qd_des`, `initial.joints`).
+        field: &'static str,
+        /// The model's joint count.
+        expected: usize,
+        /// The length given.
+        actual: usize,
+    },
+    /// An entry is NaN or infinite.
+    NonFinite {
+        /// Which vector.
+        field: &'static str,
+        /// Joint index in model order.
+        index: usize,
+        /// Joint name.
+        joint: String,
+    },
+}
+
+/// Checks that `values` has one finite entry per joint of `model`.
+pub fn check_joint_vector(
+    model: &kinematics::Model,
+    field: &'static str,
+    values: &[f64],
+) -> Result<(), JointVectorError> {
+    let expected = model.dof();
+    if values.len() != expected {
+        return Err(JointVectorError::Length {
+            field,
+            expected,
+            actual: values.len(),
+        });
+    }
+    if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+        return Err(JointVectorError::NonFinite {
+            field,
+            index,
+            joint: model.joint_names()[index].clone(),
+        });
+    }
+    Ok(())
+}
+
+impl From<JointVectorError> for SimError {
+    fn from(error: JointVectorError) -> Self {
+        match error {
+            JointVectorError::Length {
+                field,
+                expected,
+                actual,
+            } => SimError::CommandLength {
+                field,
+                expected,
+                actual,
+            },
+            JointVectorError::NonFinite {
+                field,
+                index,
+                joint,
+            } => SimError::NonFiniteCommand {
+                field,
+                index,
+                joint,
+            },
+        }
+    }
+}
+
 /// Safety metrics of the current state; the simulator also keeps their worst values.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SafetyMetrics {
@@ -266,22 +339,7 @@ impl KinematicSim {
     }
 
     fn check_command(&self, field: &'static str, values: &[f64]) -> Result<(), SimError> {
-        let expected = self.robot.model.dof();
-        if values.len() != expected {
-            return Err(SimError::CommandLength {
-                field,
-                expected,
-                actual: values.len(),
-            });
-        }
-        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
-            return Err(SimError::NonFiniteCommand {
-                field,
-                index,
-                joint: self.robot.model.joint_names()[index].clone(),
-            });
-        }
-        Ok(())
+        Ok(check_joint_vector(&self.robot.model, field, values)?)
     }
 
     fn pose(&self, e: EndEffector) -> Isometry3<f64> {

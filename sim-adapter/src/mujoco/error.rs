@@ -72,3 +72,29 @@ pub enum MujocoError {
         time: f64,
     },
 }
+
+impl From<kinematic_sim::JointVectorError> for MujocoError {
+    fn from(error: kinematic_sim::JointVectorError) -> Self {
+        use kinematic_sim::JointVectorError;
+        match error {
+            JointVectorError::Length {
+                field,
+                expected,
+                actual,
+            } => MujocoError::CommandLength {
+                field,
+                expected,
+                actual,
+            },
+            JointVectorError::NonFinite {
+                field,
+                index,
+                joint,
+            } => MujocoError::NonFiniteCommand {
+                field,
+                index,
+                joint,
+            },
+        }
+    }
+}

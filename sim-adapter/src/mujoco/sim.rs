@@ -5,7 +5,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use kinematic_sim::support::{SupportPolygon, sole_corners};
-use kinematic_sim::{SafetyMetrics, SafetySummary, SimMeasurement};
+use kinematic_sim::{SafetyMetrics, SafetySummary, SimMeasurement, check_joint_vector};
 use kinematics::configuration::Configuration;
 use kinematics::robot::{EndEffector, Robot};
 use mujoco_rs::prelude::{MjData, MjModel, MjtObjBase, MjtWarning};
@@ -78,21 +78,7 @@ impl MujocoSim {
         check_library_version()?;
         check_options(&options)?;
         let dof = robot.model.dof();
-        if initial.joints.len() != dof {
-            return Err(MujocoError::CommandLength {
-                field: "initial.joints",
-                expected: dof,
-                actual: initial.joints.len(),
-            });
-        }
-        if let Some(index) = initial.joints.iter().position(|v| !v.is_finite()) {
-            let joint = robot.model.joint_names()[index].clone();
-            return Err(MujocoError::NonFiniteCommand {
-                field: "initial.joints",
-                index,
-                joint,
-            });
-        }
+        check_joint_vector(&robot.model, "initial.joints", initial.joints.as_slice())?;
         let base = &initial.base;
         if !(base
             .translation
@@ -296,23 +282,7 @@ impl MujocoSim {
     }
 
     fn check_command(&self, field: &'static str, values: &[f64]) -> Result<(), MujocoError> {
-        let expected = self.robot.model.dof();
-        if values.len() != expected {
-            return Err(MujocoError::CommandLength {
-                field,
-                expected,
-                actual: values.len(),
-            });
-        }
-        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
-            let joint = self.robot.model.joint_names()[index].clone();
-            return Err(MujocoError::NonFiniteCommand {
-                field,
-                index,
-                joint,
-            });
-        }
-        Ok(())
+        Ok(check_joint_vector(&self.robot.model, field, values)?)
     }
 
     fn fatal_warning_count(&self) -> i64 {
