@@ -1,19 +1,22 @@
 //! `walkctl demo`: the whole system in one command.
 //!
-//! Starts `walkd` and `walk-sim` as child processes (found next to `walkctl`'s own executable),
-//! unless a `walkd` already serves the robot's services; generates a walk, post-processes it,
-//! submits it, watches it, prints the outcome and shuts the children down with SIGTERM.
+//! Starts `walkd` and `walk-sim --physics kinematic|mujoco` as child processes (found next to
+//! `walkctl`'s own executable), unless a `walkd` already serves the robot's services; generates a
+//! walk, post-processes it, submits it, watches it, prints the outcome and shuts the children
+//! down with SIGTERM. The simulator's ground truth (`sim-truth`) is recorded meanwhile, so a walk
+//! the daemon finished with the simulated robot on the floor is reported as a fall.
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use kinematics::robot::Robot;
-use shm_types::{ClockMode, DaemonState, DaemonStatus, LatencySummary, LinkState, RuntimeConfig};
+use shm_types::{ClockMode, DaemonState, DaemonStatus, LatencySummary, RuntimeConfig};
 
 use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
+use crate::evaluate::process::{Process, connect_when_fresh};
+use crate::evaluate::truth::{TruthRecorder, Verdict, judged_outcome};
 use crate::watch::StanceProgress;
 
 /// The robots with a vendored config.
@@ -42,6 +45,19 @@ impl DemoRobot {
 pub enum DemoPhysics {
     /// The deterministic kinematic simulator.
     Kinematic,
+    /// MuJoCo rigid-body dynamics with contacts (walk-sim built with --features
+    /// sim-adapter/mujoco after scripts/setup-mujoco.sh).
+    Mujoco,
+}
+
+impl DemoPhysics {
+    /// The `walk-sim --physics` value.
+    fn name(self) -> &'static str {
+        match self {
+            Self::Kinematic => "kinematic",
+            Self::Mujoco => "mujoco",
+        }
+    }
 }
 
 /// Arguments of `walkctl demo`.
@@ -88,16 +104,31 @@ pub struct DemoOutcome {
     pub distance_m: f64,
     /// Stances completed.
     pub stances: u32,
+    /// Simulated (control-tick) time from submission to the end (s).
+    pub sim_s: f64,
+    /// Wall time from submission to the end (s).
+    pub wall_s: f64,
+    /// Simulated time from submission at which the simulator's fall rule first fired (s).
+    pub fell_at_s: Option<f64>,
+    /// Largest tilt of the simulated `base_link` since submission (rad); `None` when no
+    /// simulator published its truth (e.g. a running walkd driving a real robot).
+    pub max_tilt_rad: Option<f64>,
 }
 
 impl DemoOutcome {
-    /// `done`, or the fault / state the walk ended in.
+    /// `done`, the fault / state the walk ended in, or `fell at <t> s (daemon: ...)`.
     pub fn outcome(&self) -> String {
-        match self.status.state {
+        let daemon = match self.status.state {
             DaemonState::Done => "done".to_owned(),
             DaemonState::Fault => format!("fault: {}", self.status.fault),
             other => format!("{}: {}", other.name(), self.status.fault),
-        }
+        };
+        judged_outcome(self.fell_at_s, &daemon)
+    }
+
+    /// The walk completed and the simulated robot (if any) never fell.
+    pub fn succeeded(&self) -> bool {
+        self.status.state == DaemonState::Done && self.fell_at_s.is_none()
     }
 
     fn json(&self) -> serde_json::Value {
@@ -107,6 +138,11 @@ impl DemoOutcome {
             "outcome": self.outcome(),
             "distance_m": self.distance_m,
             "stances": self.stances,
+            "sim_s": self.sim_s,
+            "wall_s": self.wall_s,
+            "real_time_factor": self.sim_s / self.wall_s,
+            "fell_at_s": self.fell_at_s,
+            "max_tilt_rad": self.max_tilt_rad,
             "deadline_misses": self.status.deadline_misses,
             "tick_us": tick(&self.status.tick_us),
             "latency_us": tick(&self.status.latency_us),
@@ -140,89 +176,25 @@ fn executable_dir() -> Option<PathBuf> {
     std::env::current_exe().ok()?.parent().map(Path::to_owned)
 }
 
-/// Child processes started by the demo; stopped with SIGTERM when dropped.
-struct Children(Vec<(&'static str, Child)>);
+/// Child processes started by the demo, oldest first; stopped with SIGTERM when dropped.
+struct Children(Vec<Process>);
 
 impl Children {
-    fn spawn(&mut self, name: &'static str, args: &[OsString]) -> anyhow::Result<()> {
-        let binary = executable_dir()
-            .map(|dir| dir.join(name))
-            .filter(|path| path.is_file())
-            .with_context(|| format!("`{name}` not found next to walkctl (build all binaries)"))?;
-        let child = Command::new(&binary)
-            .args(args)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .with_context(|| format!("cannot start {}", binary.display()))?;
-        self.0.push((name, child));
-        Ok(())
-    }
-
-    /// SIGTERM to each child (newest first), waiting up to 5 s each, then SIGKILL.
-    fn shut_down(&mut self) -> Vec<String> {
+    /// SIGTERM to each child (newest first), waiting up to 5 s each, then SIGKILL; returns what
+    /// went wrong.
+    fn shut_down(&mut self) -> anyhow::Result<Vec<String>> {
         let mut problems = Vec::new();
-        while let Some((name, mut child)) = self.0.pop() {
-            // SAFETY: kill with a pid of our own child has no memory-safety preconditions.
-            unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
-            let start = Instant::now();
-            loop {
-                match child.try_wait() {
-                    Ok(Some(status)) if status.success() => break,
-                    Ok(Some(status)) => {
-                        problems.push(format!("{name} exited with {status}"));
-                        break;
-                    }
-                    Ok(None) if start.elapsed() < Duration::from_secs(5) => {
-                        std::thread::sleep(Duration::from_millis(10));
-                    }
-                    _ => {
-                        let _ = child.kill();
-                        let _ = child.wait();
-                        problems.push(format!("{name} did not stop on SIGTERM; killed"));
-                        break;
-                    }
-                }
-            }
+        while let Some(child) = self.0.pop() {
+            problems.extend(child.stop()?.problem);
         }
-        problems
+        Ok(problems)
     }
 }
 
 impl Drop for Children {
     fn drop(&mut self) {
-        self.shut_down();
-    }
-}
-
-/// Waits until a daemon serves `prefix` and its adapter link is fresh.
-fn wait_for_daemon(
-    prefix: &str,
-    children: &mut Children,
-    timeout: Duration,
-) -> anyhow::Result<DaemonClient> {
-    let start = Instant::now();
-    loop {
-        for (name, child) in &mut children.0 {
-            if let Ok(Some(status)) = child.try_wait() {
-                bail!("{name} exited during start-up ({status})");
-            }
-        }
-        if let Ok(client) = DaemonClient::connect(prefix)
-            && client.is_running()
-            && let Ok(status) = client.status()
-            && status.link == LinkState::Fresh
-        {
-            return Ok(client);
-        }
-        if start.elapsed() > timeout {
-            bail!(
-                "walkd on `{prefix}` did not get fresh samples within {} s",
-                timeout.as_secs()
-            );
-        }
-        std::thread::sleep(Duration::from_millis(50));
+        // On an error path: stop them gracefully; the error being returned matters more.
+        let _ = self.shut_down();
     }
 }
 
@@ -278,16 +250,17 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         if let Some(rate) = args.rate_hz {
             common.extend(["--rate-hz".into(), rate.to_string().into()]);
         }
-        children.spawn("walkd", &common)?;
-        let physics = match args.physics {
-            DemoPhysics::Kinematic => "kinematic",
-        };
+        children.0.push(Process::start("walkd", &common)?);
         let mut sim_args = common;
-        sim_args.extend(["--physics".into(), physics.into()]);
-        children.spawn("walk-sim", &sim_args)?;
+        sim_args.extend(["--physics".into(), args.physics.name().into()]);
+        children.0.push(Process::start("walk-sim", &sim_args)?);
     }
-    let client = wait_for_daemon(&prefix, &mut children, Duration::from_secs(20))?;
+    let processes: Vec<&Process> = children.0.iter().collect();
+    let client = connect_when_fresh(&prefix, &processes, Duration::from_secs(20))?;
+    let recorder = TruthRecorder::start(&prefix)?;
     let start = client.status()?;
+    let wall = Instant::now();
+    let submitted_ns = shm_types::monotonic_ns();
     let id = client.submit_json(&json)?;
     let progress = (!args.json).then(StanceProgress::new);
     let timeout = Duration::from_secs(60 + 30 * stance_count as u64);
@@ -299,10 +272,12 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     if let Some(progress) = &progress {
         progress.finish();
     }
+    let wall_s = wall.elapsed().as_secs_f64();
     // Let a final status with the complete tick statistics arrive.
     let status = client.status().unwrap_or(last);
     drop(client);
-    let problems = children.shut_down();
+    let verdict = Verdict::of(&recorder.finish()?, submitted_ns);
+    let problems = children.shut_down()?;
     if !problems.is_empty() {
         bail!("shutting down: {}", problems.join("; "));
     }
@@ -314,6 +289,10 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     Ok(DemoOutcome {
         distance_m: feet_midpoint(&status)[0] - feet_midpoint(&start)[0],
         stances,
+        sim_s: last.ticks.saturating_sub(start.ticks) as f64 / last.rate_hz,
+        wall_s,
+        fell_at_s: verdict.and_then(|v| v.fell_at_s),
+        max_tilt_rad: verdict.map(|v| v.max_tilt_rad),
         status,
     })
 }
@@ -324,15 +303,24 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     if args.json {
         println!("{}", outcome.json());
     } else {
+        let tilt = outcome.max_tilt_rad.map_or_else(
+            || "no simulator truth".to_owned(),
+            |tilt| format!("{tilt:.3} rad"),
+        );
         println!(
-            "outcome: {}\ndistance covered: {:.3} m\nstances executed: {}\n{}",
+            "outcome: {}\ndistance covered: {:.3} m\nstances executed: {}\n\
+             simulated {:.2} s in {:.2} s wall (real-time factor {:.1})\n\
+             largest base tilt in the simulator: {tilt}\n{}",
             outcome.outcome(),
             outcome.distance_m,
             outcome.stances,
+            outcome.sim_s,
+            outcome.wall_s,
+            outcome.sim_s / outcome.wall_s,
             status_text(&outcome.status)
         );
     }
-    if outcome.status.state != DaemonState::Done {
+    if !outcome.succeeded() {
         bail!("the walk did not complete: {}", outcome.outcome());
     }
     Ok(())

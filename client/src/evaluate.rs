@@ -3,20 +3,24 @@
 //! For every robot × affordance set × distance × run it generates a walk (seed = run number),
 //! post-processes it, starts its own `walkd` and `walk-sim --physics <backend>` in lockstep on a
 //! service prefix of its own, submits the walk, records the daemon's status stream and stops the
-//! processes. A run succeeds when the daemon reports `done` and `walk-sim` reports no fall in
-//! its final safety summary. `--plots DIR` writes the paper's Fig. 6 per robot (first run of
-//! the first distance, feet only): target vs controller state over time for the CoM and both
-//! feet — plus the simulator's truth where the caller has it ([`write_fig6`] is shared with the
-//! in-process physics walk of the `walk-tests` package, which does).
+//! processes. Meanwhile it records the simulator's ground truth, which `walk-sim` publishes with
+//! every sample on `<prefix>/sim-truth` (true CoM, sole poses, base height and tilt, fall flag):
 //!
-//! What the process path cannot measure yet: the simulator's ground truth (CoM and foot poses)
-//! is not published over IPC, so `drift_m` is `null` and the final position error is taken from
-//! the controller's own estimate (`final_error_source: "controller"`).
+//! - success: the daemon reports `done` and the simulator's fall rule never fired;
+//! - drift: the largest distance between the controller's CoM / sole estimate in a status and
+//!   the simulator's truth of the state that status's tick saw ([`truth::state_at`]);
+//! - final position error: the simulated soles' distance from their final targets.
+//!
+//! `--plots DIR` writes the paper's Fig. 6 per robot (first run of the first distance, feet
+//! only): target vs controller state vs simulator over time for the CoM and both feet
+//! ([`write_fig6`] is shared with the in-process physics walk of the `walk-tests` package).
+
+pub(crate) mod process;
+pub(crate) mod truth;
 
 use std::ffi::OsString;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
@@ -24,10 +28,10 @@ use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::Vector3;
 use plotters::prelude::*;
-use shm_types::{DaemonState, DaemonStatus};
+use shm_types::{DaemonState, DaemonStatus, SimTruth};
 use stance::{AffordanceSet, PostProcessedSequence};
 
-use crate::daemon_client::DaemonClient;
+use process::{Process, connect_when_fresh};
 
 /// Simulator backends `walk-sim` offers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -95,6 +99,11 @@ pub struct Points {
 }
 
 impl Points {
+    /// The true CoM and sole positions a simulator reports.
+    pub fn from_truth(truth: &SimTruth) -> Self {
+        Self::from_status(&truth.com, &truth.left_foot, &truth.right_foot)
+    }
+
     /// The CoM and sole positions a daemon status reports.
     pub fn from_status(com: &[f64; 3], left_foot: &[f64; 7], right_foot: &[f64; 7]) -> Self {
         let xyz = |p: &[f64]| Vector3::new(p[0], p[1], p[2]);
@@ -195,18 +204,25 @@ pub struct RunResult {
     pub distance_m: f64,
     /// Run number (= generator seed).
     pub run: u32,
-    /// `done` and no fall reported by the simulator.
+    /// `done` and the simulator's fall rule never fired.
     pub success: bool,
-    /// `done`, `fault: <reason>`, `fell`, ...
+    /// `done`, `fault: <reason>`, `fell at <t> s (daemon: <outcome>)`, ...
     pub outcome: String,
     /// Simulated (control-tick) time from submission to the end (s).
     pub sim_s: f64,
     /// Wall time from submission to the end (s).
     pub wall_s: f64,
-    /// Largest distance of a sole from its final target at the end, controller estimate (m).
+    /// Largest distance of a simulated sole from its final target at the end (m).
     pub final_position_error_m: f64,
-    /// Simulator-vs-controller drift (m); `None` when the simulator's truth is not available.
+    /// Largest controller-vs-simulator distance of the CoM or a sole over the walk (m); `None`
+    /// when no status could be paired with a simulator state.
     pub drift_m: Option<f64>,
+    /// Statuses paired with a simulator state (the samples `drift_m` is the maximum of).
+    pub drift_samples: usize,
+    /// Largest tilt of the simulated `base_link` from the vertical during the walk (rad).
+    pub max_tilt_rad: f64,
+    /// Simulated time from submission at which the simulator's fall rule first fired (s).
+    pub fell_at_s: Option<f64>,
     /// Stances in the walk.
     pub stances: usize,
     /// The stance the daemon was moving towards at the end.
@@ -227,8 +243,10 @@ impl RunResult {
             "sim_s": self.sim_s,
             "wall_s": self.wall_s,
             "drift_m": self.drift_m,
+            "drift_samples": self.drift_samples,
+            "max_tilt_rad": self.max_tilt_rad,
+            "fell_at_s": self.fell_at_s,
             "final_position_error_m": self.final_position_error_m,
-            "final_error_source": "controller",
             "stances": self.stances,
             "stance_reached": self.stance_reached,
         })
@@ -337,46 +355,59 @@ fn run_once(
     let mut sim_args = common;
     sim_args.extend(["--physics".into(), args.physics.name().into()]);
     let sim = Process::start("walk-sim", &sim_args)?;
-    let client = connect(&prefix, &[&walkd, &sim], Duration::from_secs(30))?;
+    let client = connect_when_fresh(&prefix, &[&walkd, &sim], Duration::from_secs(30))?;
+    let recorder = truth::TruthRecorder::start(&prefix)?;
     let start = client.status()?;
     align_targets(
         &mut targets,
         &Points::from_status(&start.com, &start.left_foot, &start.right_foot),
     );
     let wall = Instant::now();
+    let submitted_ns = shm_types::monotonic_ns();
     let id = client.submit_json(&sequence.to_json_string())?;
     let mut trace = Vec::new();
+    let mut status_times = Vec::new();
     let timeout = Duration::from_secs(120 + 60 * sequence.len() as u64);
     let last = client.wait_for_sequence(id, timeout, |status| {
         if status.sequence_id == id {
             trace.push(sample(status, &start, &targets));
+            status_times.push(status.timestamp_ns);
         }
     })?;
     let wall_s = wall.elapsed().as_secs_f64();
     drop(client);
-    let walkd_log = walkd.stop()?;
-    let sim_log = sim.stop()?;
-    let fell = reported_fall(&sim_log)
-        .with_context(|| format!("walk-sim's log:\n{sim_log}\nwalkd's log:\n{walkd_log}"))?;
-    let end = Points::from_status(&last.com, &last.left_foot, &last.right_foot);
+    let states = recorder.finish()?;
+    let walkd_log = walkd.stop()?.log;
+    let sim_log = sim.stop()?.log;
+    let Some(verdict) = truth::Verdict::of(&states, submitted_ns) else {
+        bail!(
+            "walk-sim published no simulator truth on `{prefix}/sim-truth`\n\
+             walk-sim's log:\n{sim_log}\nwalkd's log:\n{walkd_log}"
+        );
+    };
+    let drift = pair_with_truth(&mut trace, &status_times, &states);
+    let end = Points::from_truth(&verdict.end);
     let final_target = targets[targets.len() - 1];
     let done = last.state == DaemonState::Done;
-    let outcome = match (done, fell) {
-        (_, true) => "fell".to_owned(),
-        (true, false) => "done".to_owned(),
-        (false, false) => format!("{}: {}", last.state.name(), last.fault),
+    let daemon_outcome = if done {
+        "done".to_owned()
+    } else {
+        format!("{}: {}", last.state.name(), last.fault)
     };
     Ok(RunResult {
         robot: robot.to_owned(),
         affordances,
         distance_m: distance,
         run,
-        success: done && !fell,
-        outcome,
+        success: done && verdict.fell_at_s.is_none(),
+        outcome: truth::judged_outcome(verdict.fell_at_s, &daemon_outcome),
         sim_s: (last.ticks - start.ticks) as f64 / last.rate_hz,
         wall_s,
         final_position_error_m: end.distances(&final_target).1,
-        drift_m: None,
+        drift_m: drift.map(|(largest, _)| largest),
+        drift_samples: drift.map_or(0, |(_, samples)| samples),
+        max_tilt_rad: verdict.max_tilt_rad,
+        fell_at_s: verdict.fell_at_s,
         stances: sequence.len(),
         stance_reached: last.stance_index,
         trace,
@@ -394,123 +425,31 @@ fn sample(status: &DaemonStatus, start: &DaemonStatus, targets: &[Points]) -> Tr
     }
 }
 
-/// `fell=true|false` from walk-sim's final safety summary (its "walk-sim stopped" log line).
-fn reported_fall(log: &str) -> anyhow::Result<bool> {
-    let line = log
-        .lines()
-        .rfind(|line| line.contains("walk-sim stopped"))
-        .context("walk-sim did not log its final safety summary (`walk-sim stopped`)")?;
-    if line.contains("fell=true") {
-        Ok(true)
-    } else if line.contains("fell=false") {
-        Ok(false)
-    } else {
-        bail!("walk-sim's final summary has no `fell=` field: {line}")
+/// Puts the simulator's state into every trace sample whose status (written at `status_times`)
+/// pairs with one; returns the largest controller-vs-simulator distance of the CoM or a sole
+/// and the number of paired samples, or `None` when none paired.
+fn pair_with_truth(
+    trace: &mut [TraceSample],
+    status_times: &[u64],
+    states: &[SimTruth],
+) -> Option<(f64, usize)> {
+    let mut drift: Option<(f64, usize)> = None;
+    for (sample, &time) in trace.iter_mut().zip(status_times) {
+        let Some(state) = truth::state_at(states, time) else {
+            continue;
+        };
+        let sim = Points::from_truth(state);
+        let (com, feet) = sample.controller.distances(&sim);
+        let (largest, samples) = drift.unwrap_or((0.0, 0));
+        drift = Some((largest.max(com).max(feet), samples + 1));
+        sample.sim = Some(sim);
     }
-}
-
-/// Waits until the daemon on `prefix` serves with a fresh adapter link.
-fn connect(
-    prefix: &str,
-    processes: &[&Process],
-    timeout: Duration,
-) -> anyhow::Result<DaemonClient> {
-    let start = Instant::now();
-    loop {
-        for process in processes {
-            process.check_running()?;
-        }
-        if let Ok(client) = DaemonClient::connect(prefix)
-            && client.is_running()
-            && let Ok(status) = client.status()
-            && status.link == shm_types::LinkState::Fresh
-        {
-            return Ok(client);
-        }
-        if start.elapsed() > timeout {
-            bail!("walkd on `{prefix}` did not get fresh samples within {timeout:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
-
-/// A child process (found next to `walkctl`) whose stderr goes to a temporary log file; killed
-/// if dropped while it runs.
-struct Process {
-    name: &'static str,
-    child: std::cell::RefCell<Child>,
-    log: PathBuf,
-}
-
-impl Process {
-    fn start(name: &'static str, args: &[OsString]) -> anyhow::Result<Self> {
-        let binary = std::env::current_exe()?
-            .parent()
-            .map(|dir| dir.join(name))
-            .filter(|path| path.is_file())
-            .with_context(|| format!("`{name}` not found next to walkctl (build all binaries)"))?;
-        static COUNT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-        let n = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let log = std::env::temp_dir().join(format!(
-            "walkctl-evaluate-{}-{name}-{n}.log",
-            std::process::id()
-        ));
-        let child = Command::new(&binary)
-            .args(args)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(std::fs::File::create(&log)?)
-            .spawn()
-            .with_context(|| format!("cannot start {}", binary.display()))?;
-        Ok(Self {
-            name,
-            child: std::cell::RefCell::new(child),
-            log,
-        })
-    }
-
-    fn check_running(&self) -> anyhow::Result<()> {
-        if let Ok(Some(status)) = self.child.borrow_mut().try_wait() {
-            let log = std::fs::read_to_string(&self.log).unwrap_or_default();
-            bail!("{} exited during start-up ({status}):\n{log}", self.name);
-        }
-        Ok(())
-    }
-
-    /// SIGTERM, wait up to 5 s (then SIGKILL); returns the process's log.
-    fn stop(self) -> anyhow::Result<String> {
-        let mut child = self.child.borrow_mut();
-        // SAFETY: kill with the pid of our own child has no memory-safety preconditions.
-        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
-        let start = Instant::now();
-        while child.try_wait()?.is_none() {
-            if start.elapsed() > Duration::from_secs(5) {
-                child.kill()?;
-                child.wait()?;
-                break;
-            }
-            std::thread::sleep(Duration::from_millis(10));
-        }
-        drop(child);
-        let log = std::fs::read_to_string(&self.log).unwrap_or_default();
-        Ok(log)
-    }
-}
-
-impl Drop for Process {
-    fn drop(&mut self) {
-        let child = self.child.get_mut();
-        if matches!(child.try_wait(), Ok(None)) {
-            let _ = child.kill();
-            let _ = child.wait();
-        }
-        let _ = std::fs::remove_file(&self.log);
-    }
+    drift
 }
 
 fn row(r: &RunResult) -> String {
     format!(
-        "{:<8} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) final error {:.4} m stance {}/{}",
+        "{:<8} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) final error {:.4} m drift {} max tilt {:.3} rad stance {}/{}",
         r.robot,
         r.affordances.name(),
         r.distance_m,
@@ -521,6 +460,9 @@ fn row(r: &RunResult) -> String {
         r.wall_s,
         r.sim_s / r.wall_s,
         r.final_position_error_m,
+        r.drift_m
+            .map_or_else(|| "n/a".to_owned(), |d| format!("{d:.4} m")),
+        r.max_tilt_rad,
         r.stance_reached,
         r.stances
     )

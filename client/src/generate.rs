@@ -1,10 +1,11 @@
-//! `walkctl generate`: a human-like, impeded raw stance sequence for a robot (the stance source
-//! until an n-gram generator exists).
+//! `walkctl generate`: a human-like, impeded raw stance sequence for a robot, from the learned
+//! n-gram model (`--model`) or the synthetic generator (`stance::learned::source`).
 
 use std::path::PathBuf;
 
 use anyhow::Context;
-use stance::{AffordanceSet, GenerateOptions, generate_with_railing};
+use stance::learned::SourceArgs;
+use stance::{AffordanceSet, GenerateOptions};
 
 use crate::postprocess::{ParamOverrides, load_robot};
 
@@ -40,7 +41,7 @@ pub struct GenerateArgs {
     #[command(flatten)]
     pub params: ParamOverrides,
     #[command(flatten)]
-    pub source: crate::learn::SourceArgs,
+    pub source: SourceArgs,
 }
 
 fn parse_interval(text: &str) -> Result<[f64; 2], String> {
@@ -67,13 +68,17 @@ pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
         affordances: args.affordances,
         seed: args.seed,
     };
-    let learned = args
+    let sourced = args
         .source
-        .generate(&robot, distance, args.affordances, railing, args.seed)?;
-    let raw = match learned {
-        Some(learned) => learned,
-        None => generate_with_railing(&robot, &options, railing)?,
-    };
+        .load()?
+        .generate(&robot, &options, Some(railing))?;
+    if let Some([position, orientation]) = sourced.largest_ik_error {
+        eprintln!(
+            "retargeted {} stances: largest IK error {position:.1e} m, {orientation:.1e} rad",
+            sourced.raw.len()
+        );
+    }
+    let raw = sourced.raw;
     std::fs::write(&args.output, raw.to_json_string())
         .with_context(|| format!("writing {}", args.output.display()))?;
     eprintln!(

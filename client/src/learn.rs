@@ -1,17 +1,15 @@
 //! `walkctl learn`: train the n-gram stance model on demonstration folders (each with a
 //! `demo.toml` manifest) and write it as JSON; optionally report realism against a held-out
-//! folder. Also the learned stance source of `walkctl generate` ([`SourceArgs`]).
+//! folder.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
-use kinematics::robot::Robot;
+use anyhow::Context;
 use stance::learned::realism::{WalkStatistics, of_generated, of_keyframes};
 use stance::learned::{
-    LearnedOptions, NgramModel, Query, Search, SegmentOptions, TrainOptions, generate_learned,
-    generate_tokens, load_folder, segment, taxonomy_label,
+    NgramModel, Query, Search, SegmentOptions, TrainOptions, generate_tokens, load_folder, segment,
+    taxonomy_label,
 };
-use stance::{AffordanceSet, RawSequence};
 
 /// Arguments of `walkctl learn`.
 #[derive(Debug, Clone, clap::Args)]
@@ -122,59 +120,4 @@ fn print_statistics(name: &str, statistics: &WalkStatistics) {
     println!("  step length [m]     {}", statistics.step_length);
     println!("  step width [m]      {}", statistics.step_width);
     println!("  stance duration [s] {}", statistics.stance_duration);
-}
-
-/// The stance source options of `walkctl generate` (flattened into its arguments).
-#[derive(Debug, Clone, clap::Args)]
-pub struct SourceArgs {
-    /// Stance source: `learned` (n-gram model, the default when --model is given) or `synthetic`.
-    #[arg(long, value_name = "SOURCE")]
-    pub source: Option<String>,
-    /// Trained n-gram model (see `walkctl learn`), e.g. data/models/default-ngram.json.
-    #[arg(long, value_name = "MODEL.json")]
-    pub model: Option<PathBuf>,
-    /// With a model: the most probable sequence (beam search of this width) instead of a
-    /// sequence sampled with --seed.
-    #[arg(long, value_name = "WIDTH")]
-    pub beam: Option<usize>,
-}
-
-impl SourceArgs {
-    /// Generates from the learned model when one is selected, `Ok(None)` for the synthetic
-    /// source. `distance` and `railing` (the part of the path where the railing is available)
-    /// are raw-scale metres (already divided by scf).
-    pub fn generate(
-        &self,
-        robot: &Robot,
-        distance: f64,
-        affordances: AffordanceSet,
-        railing: [f64; 2],
-        seed: u64,
-    ) -> anyhow::Result<Option<RawSequence>> {
-        let model_path = match (self.source.as_deref(), &self.model) {
-            (Some("synthetic"), _) | (None, None) => return Ok(None),
-            (Some("learned") | None, Some(path)) => path,
-            (Some("learned"), None) => bail!("--source learned needs --model MODEL.json"),
-            (Some(other), _) => bail!("unknown --source `{other}` (learned or synthetic)"),
-        };
-        let model = NgramModel::from_path(model_path)?;
-        let options = LearnedOptions {
-            distance,
-            affordances,
-            railing: Some(railing),
-            search: self.beam.map_or(Search::Sample(seed), Search::Beam),
-        };
-        let retargeted = generate_learned(robot, &model, &options)?;
-        let errors = &retargeted.ik_errors;
-        let worst = errors
-            .iter()
-            .fold([0.0f64; 2], |w, e| [w[0].max(e[0]), w[1].max(e[1])]);
-        eprintln!(
-            "retargeted {} stances: largest IK error {:.1e} m, {:.1e} rad",
-            errors.len(),
-            worst[0],
-            worst[1]
-        );
-        Ok(Some(retargeted.raw))
-    }
 }

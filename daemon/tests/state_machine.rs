@@ -194,3 +194,39 @@ fn sequences_with_an_overlong_step_or_another_robot_are_refused() {
     let other = walk_support::synthetic_walk(&armar, 1, 0.05, false);
     assert!(daemon::controller::Controller::prepare(&robot, &config, &other).is_err());
 }
+
+#[test]
+fn an_imu_that_disagrees_with_leg_odometry_is_a_tipping_fault_that_holds() {
+    let mut h = started("jvrc1", false);
+    for _ in 0..50 {
+        h.tick();
+    }
+    assert_eq!(h.controller.status().state, ControllerState::Executing);
+    let config = walk_support::controller_config("jvrc1");
+    let m = h.sim.measurement().clone();
+    // The IMU reports the base rolled just under, then just over, the detection angle.
+    let roll = |angle: f64| {
+        nalgebra::UnitQuaternion::from_euler_angles(angle, 0.0, 0.0) * m.base_orientation
+    };
+    for (angle, tipping) in [
+        (0.9 * config.tipping_detection_rad, false),
+        (1.1 * config.tipping_detection_rad, true),
+    ] {
+        let measurement = daemon::controller::Measurement {
+            q: m.q.as_slice(),
+            qd: m.qd.as_slice(),
+            wrenches: &m.wrenches,
+            imu_orientation: Some(roll(angle)),
+        };
+        let before = h.command.q_des.clone();
+        h.controller.tick(&measurement, h.dt, &mut h.command);
+        if tipping {
+            assert_eq!(h.controller.status().state, ControllerState::Fault);
+            assert_eq!(h.controller.status().fault, FaultCode::Tipping);
+            assert_eq!(h.command.q_des, before, "holds the last command");
+            assert_eq!(h.command.mode, CommandMode::Hold);
+        } else {
+            assert_eq!(h.controller.status().state, ControllerState::Executing);
+        }
+    }
+}

@@ -32,6 +32,10 @@ pub struct RuntimeConfig {
     /// Lock the daemon's memory (`mlockall`) so page faults cannot stall the control loop.
     #[serde(default)]
     pub lock_memory: bool,
+    /// The daemon busy-polls for each sample from this long (µs) before to this long after its
+    /// expected time instead of sleeping through it (0: sleep and wait for the sample event).
+    #[serde(default)]
+    pub spin_us: u32,
 }
 
 fn default_rate_hz() -> f64 {

@@ -10,14 +10,16 @@
 //! | `status` | publish-subscribe | daemon → clients | [`DaemonStatus`] |
 //! | `stances` | request-response | client → daemon | JSON bytes → [`SubmitReply`] |
 //! | `control` | request-response | client → daemon | [`ControlRequest`] → [`ControlReply`] |
+//! | `sim-truth` | publish-subscribe | simulator → clients | [`SimTruth`] |
 //!
 //! Every message type is `#[repr(C)]`, `ZeroCopySend` and carries a `#[type_name]` that contains
 //! the [`PROTOCOL_VERSION`]; a peer built against another protocol version is refused by iceoryx2
 //! when it opens a service and the port wrappers turn that into [`ShmError::ProtocolMismatch`].
 //!
 //! Processes never touch iceoryx2 directly: each role has a typed port wrapper
-//! ([`DaemonLoopPorts`] + [`DaemonServicePorts`], [`AdapterPorts`], [`ClientPorts`]) that opens the
-//! services with the one set of QoS settings defined in [`services`].
+//! ([`DaemonLoopPorts`] + [`DaemonServicePorts`], [`AdapterPorts`], [`ClientPorts`], and for the
+//! simulator's ground truth [`TruthPublisher`] + [`TruthSubscriber`]) that opens the services with
+//! the one set of QoS settings defined in [`services`].
 
 mod clock;
 pub mod config;
@@ -28,7 +30,9 @@ pub mod process;
 pub mod services;
 mod text;
 
-pub use ports::{AdapterPorts, ClientPorts, DaemonLoopPorts, DaemonServicePorts};
+pub use ports::{
+    AdapterPorts, ClientPorts, DaemonLoopPorts, DaemonServicePorts, TruthPublisher, TruthSubscriber,
+};
 
 pub use clock::{monotonic_ns, sleep_until};
 pub use config::{ConfigError, RuntimeConfig};
@@ -36,7 +40,7 @@ pub use error::ShmError;
 pub use messages::{
     ClockMode, CommandMode, ControlCommand, ControlReply, ControlRequest, DaemonState,
     DaemonStatus, HISTOGRAM_BUCKETS, JointCommand, LatencySummary, LinkState, LogHistogram,
-    SensorSample, SubmitReply, WRENCH_ORDER,
+    SensorSample, SimTruth, SubmitReply, WRENCH_ORDER,
 };
 
 pub use services::ServiceNames;

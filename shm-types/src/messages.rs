@@ -374,6 +374,58 @@ impl Default for DaemonStatus {
     }
 }
 
+/// The simulated robot's true state, simulator → evaluation clients (`sim-truth` service).
+///
+/// What a real robot cannot report: `walk-sim` publishes one with every sensor sample so a client
+/// can measure how far the controller's estimate (in [`DaemonStatus`]) drifts from the simulated
+/// robot, and judge falls from the simulator's base height and tilt. Poses use the conventions of
+/// [`DaemonStatus`] (world frame, translation xyz + quaternion xyzw of the sole frames).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[type_name("walk.v1.SimTruth")]
+pub struct SimTruth {
+    /// Strictly increasing per simulator run (a gap means a subscriber missed messages).
+    pub seq: u64,
+    /// When this state was read, [`crate::monotonic_ns`]: just before the sensor sample taken
+    /// from the same state was published, so it orders with the daemon's status time stamps.
+    pub timestamp_ns: u64,
+    /// Simulated time since the simulator started (s).
+    pub sim_time_s: f64,
+    /// Centre of mass in the world (m).
+    pub com: [f64; 3],
+    /// Left sole pose: translation xyz + quaternion xyzw.
+    pub left_foot: [f64; 7],
+    /// Right sole pose: translation xyz + quaternion xyzw.
+    pub right_foot: [f64; 7],
+    /// Height of the robot's `base_link` (pelvis) origin above the floor (m).
+    pub base_height_m: f64,
+    /// Angle between the `base_link` z axis and the world vertical (rad).
+    pub tilt_rad: f64,
+    /// Whether the simulator's fall rule fired at any time since the start (it stays set).
+    pub fallen: bool,
+}
+
+impl SimTruth {
+    /// An all-zero state (identity orientations, not fallen).
+    pub const ZERO: Self = Self {
+        seq: 0,
+        timestamp_ns: 0,
+        sim_time_s: 0.0,
+        com: [0.0; 3],
+        left_foot: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+        right_foot: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+        base_height_m: 0.0,
+        tilt_rad: 0.0,
+        fallen: false,
+    };
+}
+
+impl Default for SimTruth {
+    fn default() -> Self {
+        Self::ZERO
+    }
+}
+
 /// The daemon's answer to a submitted sequence.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
@@ -492,6 +544,7 @@ mod tests {
                 ControlRequest::type_name(),
                 ControlCommand::type_name(),
                 ControlReply::type_name(),
+                SimTruth::type_name(),
                 FixedText::<8>::type_name(),
             ]
         };

@@ -17,7 +17,7 @@ use iceoryx2::service::port_factory::{event, publish_subscribe, request_response
 
 use crate::{
     ControlReply, ControlRequest, DaemonStatus, JointCommand, PROTOCOL_VERSION, SensorSample,
-    ShmError, SubmitReply,
+    ShmError, SimTruth, SubmitReply,
 };
 
 /// The names of one robot's services: `<prefix>/sensors`, `<prefix>/commands`, ...
@@ -32,6 +32,7 @@ const COMMANDS: &str = "commands";
 const STATUS: &str = "status";
 const STANCES: &str = "stances";
 const CONTROL: &str = "control";
+pub(crate) const SIM_TRUTH: &str = "sim-truth";
 
 impl ServiceNames {
     /// Names under `prefix` (e.g. `walk/armar4`); fails if a resulting name is not a valid
@@ -46,7 +47,7 @@ impl ServiceNames {
                 detail: "the service prefix is empty".to_owned(),
             });
         }
-        for kind in [SENSORS, COMMANDS, STATUS, STANCES, CONTROL] {
+        for kind in [SENSORS, COMMANDS, STATUS, STANCES, CONTROL, SIM_TRUTH] {
             names.service_name(kind)?;
         }
         Ok(names)
@@ -237,6 +238,29 @@ pub(crate) fn status(
             .map_err(|e| pubsub_error(&service, e)),
         Access::OpenOnly => builder.open().map_err(|e| pubsub_open_error(&service, e)),
     }
+}
+
+/// Messages of `sim-truth` a subscriber can hold before the oldest is dropped: 0.5 s of samples
+/// at 2 kHz, or about 70 ms of a lockstep run going 15 000 samples per wall second.
+pub const SIM_TRUTH_BUFFER: usize = 1024;
+
+/// The simulator's ground truth: published with every sample, read by evaluation clients that
+/// drain it continuously. Both sides open or create it, so either may start first.
+pub(crate) fn sim_truth(
+    node: &IpcNode,
+    names: &ServiceNames,
+) -> Result<PubSub<SimTruth>, ShmError> {
+    let service = names.full(SIM_TRUTH);
+    node.service_builder(&names.service_name(SIM_TRUTH)?)
+        .publish_subscribe::<SimTruth>()
+        .enable_safe_overflow(true)
+        .history_size(1)
+        .subscriber_max_buffer_size(SIM_TRUTH_BUFFER)
+        .subscriber_max_borrowed_samples(2)
+        .max_publishers(2)
+        .max_subscribers(4)
+        .open_or_create()
+        .map_err(|e| pubsub_error(&service, e))
 }
 
 /// Opens a client → daemon request-response service: few clients, one answer per request.

@@ -5,10 +5,13 @@
 //! - [`run_adapter`]: the adapter loop shared by every robot: publishes samples through
 //!   [`shm_types::AdapterPorts`], applies commands, and holds position when commands go stale.
 //! - [`KinematicRobot`]: [`RobotIo`] over the kinematic simulator (`--physics kinematic`).
+//! - [`GroundTruth`], [`PublishTruth`]: a simulated robot's true state on the `sim-truth`
+//!   service, for evaluation (drift of the controller's estimate, fall judgement).
 
 mod adapter_loop;
 mod kinematic;
 mod robot_io;
+mod truth;
 
 /// The MuJoCo physics backend (feature `mujoco`; library from scripts/setup-mujoco.sh).
 #[cfg(feature = "mujoco")]
@@ -17,3 +20,4 @@ pub mod mujoco;
 pub use adapter_loop::{AdapterError, AdapterOptions, AdapterReport, run_adapter};
 pub use kinematic::KinematicRobot;
 pub use robot_io::RobotIo;
+pub use truth::{GroundTruth, PublishTruth};

@@ -1,10 +1,14 @@
-//! Process life cycle: SIGTERM / SIGINT shutdown, restart after `kill -9`.
+//! Process life cycle: SIGTERM / SIGINT shutdown, restart after `kill -9`, systemd
+//! notifications.
 
+use std::os::unix::net::UnixDatagram;
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use shm_types::{DaemonState, LinkState};
 use walk_tests::{
-    connect_when_fresh, start_sim, start_walkd, unique_prefix, wait_for_status, walk_json,
+    connect_when_fresh, start_sim, start_walkd, start_walkd_with_env, unique_prefix,
+    wait_for_status, walk_json,
 };
 
 const START: Duration = Duration::from_secs(20);
@@ -90,4 +94,139 @@ fn walkd_restarts_after_kill_9_and_cleans_stale_resources() {
         .submit_json(&json)
         .unwrap_or_else(|e| panic!("{e}\n{}", second.log()));
     assert!(id >= 1);
+}
+
+/// A unix datagram socket standing in for systemd's notification socket (`NOTIFY_SOCKET`).
+struct NotifySocket {
+    socket: UnixDatagram,
+    path: PathBuf,
+    /// Every message received so far, in order.
+    messages: Vec<String>,
+}
+
+impl NotifySocket {
+    fn bind(name: &str) -> Self {
+        let path =
+            std::env::temp_dir().join(format!("walk-e2e-{name}-{}.sock", std::process::id()));
+        let _ = std::fs::remove_file(&path);
+        let socket = UnixDatagram::bind(&path).unwrap();
+        socket
+            .set_read_timeout(Some(Duration::from_millis(50)))
+            .unwrap();
+        Self {
+            socket,
+            path,
+            messages: Vec::new(),
+        }
+    }
+
+    /// Receives until a message satisfies `wanted` or `timeout` passes; returns its index.
+    fn wait_for(&mut self, timeout: Duration, wanted: impl Fn(&str) -> bool) -> Option<usize> {
+        if let Some(index) = self.messages.iter().position(|m| wanted(m)) {
+            return Some(index);
+        }
+        let start = Instant::now();
+        let mut buffer = [0u8; 4096];
+        while start.elapsed() < timeout {
+            if let Ok(n) = self.socket.recv(&mut buffer) {
+                let message = String::from_utf8_lossy(&buffer[..n]).trim_end().to_owned();
+                let hit = wanted(&message);
+                self.messages.push(message);
+                if hit {
+                    return Some(self.messages.len() - 1);
+                }
+            }
+        }
+        None
+    }
+
+    /// Receives whatever arrives within `duration`.
+    fn collect_for(&mut self, duration: Duration) {
+        let _ = self.wait_for(duration, |_| false);
+    }
+
+    fn count(&self, message: &str) -> usize {
+        self.messages
+            .iter()
+            .filter(|m| m.as_str() == message)
+            .count()
+    }
+}
+
+impl Drop for NotifySocket {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// walkd tells systemd READY=1 once it serves, STATUS= with its state, WATCHDOG=1 only when
+/// systemd asks for it (`WATCHDOG_USEC`), and STOPPING=1 on SIGTERM before exiting 0.
+#[test]
+fn walkd_notifies_systemd_ready_status_watchdog_and_stopping() {
+    for watchdog in [true, false] {
+        let name = if watchdog {
+            "notify-watchdog"
+        } else {
+            "notify"
+        };
+        let prefix = unique_prefix(name);
+        let mut notify = NotifySocket::bind(name);
+        let mut env = vec![("NOTIFY_SOCKET", notify.path.as_os_str())];
+        if watchdog {
+            // 2 s like configs/walkd@.service's WatchdogSec.
+            env.push(("WATCHDOG_USEC", "2000000".as_ref()));
+        }
+        let mut walkd = start_walkd_with_env("armar4", &prefix, "realtime", 500.0, &env).unwrap();
+        let _sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
+
+        let ready = notify.wait_for(START, |m| m == "READY=1");
+        assert!(
+            ready.is_some(),
+            "{name}: no READY=1 ({:?})\n{}",
+            notify.messages,
+            walkd.log()
+        );
+        let status = notify.wait_for(START, |m| m.starts_with("STATUS="));
+        assert!(
+            status.is_some(),
+            "{name}: no STATUS= ({:?})",
+            notify.messages
+        );
+        // The first status goes out before the adapter is connected; a later one says so.
+        let fresh = notify.wait_for(START, |m| {
+            m.starts_with("STATUS=") && m.contains("adapter fresh")
+        });
+        assert!(
+            fresh.is_some(),
+            "{name}: no STATUS= with a fresh adapter ({:?})",
+            notify.messages
+        );
+        // Status (and with it the watchdog) goes out at 20 Hz: 0.5 s gives about 10.
+        notify.collect_for(Duration::from_millis(500));
+        let watchdogs = notify.count("WATCHDOG=1");
+        if watchdog {
+            assert!(
+                watchdogs >= 5,
+                "{name}: {watchdogs} WATCHDOG=1 in 0.5 s+ ({:?})",
+                notify.messages
+            );
+        } else {
+            assert_eq!(watchdogs, 0, "{name}: WATCHDOG=1 without WATCHDOG_USEC");
+        }
+
+        walkd.signal(libc::SIGTERM);
+        let exit = walkd.wait_exit(Duration::from_secs(5));
+        assert_eq!(
+            exit.and_then(|s| s.code()),
+            Some(0),
+            "{name}: {}",
+            walkd.log()
+        );
+        let stopping = notify.wait_for(Duration::from_secs(1), |m| m == "STOPPING=1");
+        assert!(
+            stopping > ready,
+            "{name}: STOPPING=1 must follow READY=1 ({:?})",
+            notify.messages
+        );
+    }
 }

@@ -1,9 +1,12 @@
 //! A walk completes end to end: `walkctl demo` starts real `walkd` and `walk-sim` processes,
-//! generates, post-processes, submits and watches a walk, and shuts them down.
+//! generates, post-processes, submits and watches a walk, and shuts them down. `walkctl
+//! evaluate` does the same in lockstep and judges the walk from the simulator's ground truth
+//! (`sim-truth`): under MuJoCo physics (walk-sim must be built with `--features
+//! sim-adapter/mujoco`; otherwise the test fails with walk-sim's explanation) and kinematically.
 
 use std::process::Command;
 
-use walk_tests::{bin_dir, config, unique_prefix};
+use walk_tests::{bin_dir, config, unique_prefix, workspace_dir};
 
 /// Runs `walkctl demo --json` and checks the reported outcome.
 fn demo_walk(test: &str, robot: &str, clock: &str) {
@@ -66,4 +69,58 @@ fn armar4_walks_in_real_time_at_500_hz() {
 #[test]
 fn jvrc1_walks_in_real_time_at_500_hz() {
     demo_walk("jvrc1_realtime", "jvrc1", "realtime");
+}
+
+/// Runs `walkctl evaluate` for one short feet-only walk of `robot` and returns its JSON run.
+fn evaluate_walk(robot: &str, physics: &str, distance: f64) -> serde_json::Value {
+    let output = Command::new(bin_dir().join("walkctl"))
+        .args(["evaluate", "--robots", robot, "--affordances", "feet"])
+        .args(["--distances", &distance.to_string(), "--runs", "1"])
+        .args(["--physics", physics, "--json"])
+        .args([
+            "--config-dir",
+            &workspace_dir().join("configs").display().to_string(),
+        ])
+        .output()
+        .expect("walkctl runs (build the binaries first: cargo build --release --bins)");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let report: serde_json::Value = serde_json::from_str(stdout.trim())
+        .unwrap_or_else(|e| panic!("no JSON report ({e}); stdout: {stdout}\nstderr: {stderr}"));
+    let run = report["runs"][0].clone();
+    assert_eq!(run["outcome"], "done", "{run}\n{stderr}");
+    assert_eq!(
+        run["success"], true,
+        "done but fell in the simulator: {run}"
+    );
+    assert!(output.status.success(), "{stderr}");
+    run
+}
+
+/// The simulator's truth was paired with the daemon's statuses: the controller's CoM and sole
+/// estimates stayed within `max_drift` of the simulated robot, which ended near its final
+/// targets.
+fn assert_tracked_truth(run: &serde_json::Value, max_drift: f64) {
+    assert!(run["drift_samples"].as_u64().unwrap() >= 3, "{run}");
+    let drift = run["drift_m"].as_f64().unwrap();
+    assert!((0.0..max_drift).contains(&drift), "drift {drift} m: {run}");
+    assert!(
+        run["final_position_error_m"].as_f64().unwrap() < 0.03,
+        "{run}"
+    );
+    assert!(run["sim_s"].as_f64().unwrap() > 0.0, "{run}");
+}
+
+#[test]
+fn jvrc1_walks_under_mujoco_physics_without_falling() {
+    let run = evaluate_walk("jvrc1", "mujoco", 0.4);
+    assert_tracked_truth(&run, 0.02);
+    // Upright all the way (the fall rule is 0.6 rad).
+    assert!(run["max_tilt_rad"].as_f64().unwrap() < 0.1, "{run}");
+}
+
+#[test]
+fn kinematic_evaluation_pairs_the_simulator_truth_with_the_status() {
+    let run = evaluate_walk("armar4", "kinematic", 0.2);
+    assert_tracked_truth(&run, 0.005);
 }

@@ -52,6 +52,16 @@ pub struct Proc {
 impl Proc {
     /// Starts `binary` (from [`bin_dir`]) with `args`.
     pub fn start(binary: &str, args: &[String]) -> anyhow::Result<Self> {
+        Self::start_with_env(binary, args, &[])
+    }
+
+    /// Starts `binary` like [`Proc::start`], with extra environment variables (e.g. systemd's
+    /// `NOTIFY_SOCKET`).
+    pub fn start_with_env(
+        binary: &str,
+        args: &[String],
+        env: &[(&str, &std::ffi::OsStr)],
+    ) -> anyhow::Result<Self> {
         let path = bin_dir().join(binary);
         anyhow::ensure!(
             path.is_file(),
@@ -64,6 +74,7 @@ impl Proc {
             std::env::temp_dir().join(format!("walk-e2e-{}-{binary}-{n}.log", std::process::id()));
         let child = Command::new(&path)
             .args(args)
+            .envs(env.iter().copied())
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(std::fs::File::create(&log)?)
@@ -154,9 +165,20 @@ fn process_args(robot: &str, prefix: &str, clock: &str, rate_hz: f64) -> Vec<Str
 
 /// Starts `walkd` for `robot` on `prefix` (memory locking off: tests run unprivileged).
 pub fn start_walkd(robot: &str, prefix: &str, clock: &str, rate_hz: f64) -> anyhow::Result<Proc> {
+    start_walkd_with_env(robot, prefix, clock, rate_hz, &[])
+}
+
+/// Starts `walkd` like [`start_walkd`], with extra environment variables.
+pub fn start_walkd_with_env(
+    robot: &str,
+    prefix: &str,
+    clock: &str,
+    rate_hz: f64,
+    env: &[(&str, &std::ffi::OsStr)],
+) -> anyhow::Result<Proc> {
     let mut args = process_args(robot, prefix, clock, rate_hz);
     args.push("--no-lock-memory".into());
-    Proc::start("walkd", &args)
+    Proc::start_with_env("walkd", &args, env)
 }
 
 /// Starts `walk-sim --physics kinematic` for `robot` on `prefix`.

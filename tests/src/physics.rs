@@ -43,7 +43,7 @@ pub struct PhysicsWalkOptions {
     pub settle_s: f64,
     /// Every this many ticks one [`TraceSample`] is recorded (0: no trace).
     pub trace_every: u64,
-    /// The physics model (default: [`stiff_servos`]).
+    /// The physics model (the walk-sim defaults).
     pub mujoco: MujocoOptions,
 }
 
@@ -55,22 +55,8 @@ impl Default for PhysicsWalkOptions {
             time_limit_s: None,
             settle_s: 1.0,
             trace_every: 10,
-            mujoco: stiff_servos(),
+            mujoco: MujocoOptions::default(),
         }
-    }
-}
-
-/// The physics model of the walks: stiffer joint servos than `MujocoOptions::default()`
-/// (kp 1e5 N·m/rad, kv 1000 N·m·s/rad) with the rotor inertia of geared joints (armature
-/// 0.2 kg·m², which keeps kp·h²/armature at 0.5 for 1 ms steps). With the default servos the
-/// stance leg's joints yield under the robot's weight fast enough that the controller's
-/// proportional tasks settle millimetres off their targets (a lifted foot 7.5 mm off its goal).
-pub fn stiff_servos() -> MujocoOptions {
-    MujocoOptions {
-        servo_stiffness: 1e5,
-        servo_damping: 1000.0,
-        armature: 0.2,
-        ..MujocoOptions::default()
     }
 }
 

@@ -4,12 +4,16 @@
 //! on every core), it starts real `walkd` and `walk-sim --physics kinematic` processes (found
 //! next to this executable) on a service prefix of its own, submits a long walk, lets it run for
 //! `--seconds` (default 60), reads the daemon's statistics and prints a Markdown report with the
-//! percentiles and histograms. Not a test: targets are reported, not asserted.
+//! percentiles and histograms, plus walkd's own timing log: how late its timer wake-ups came and,
+//! for each deadline miss, where the time went (wake-up, sample, pickup, tick). Not a test:
+//! targets are reported, not asserted.
 //!
 //! ```text
-//! cargo build --release --bins && target/release/latency-report [--seconds 60] [--rates 500,1000] [--fifo-priority 80]
+//! cargo build --release --bins && target/release/latency-report [--seconds 60] [--rates 500,1000] \
+//!     [--loads idle,busy] [--spin-us N] [--fifo-priority 80]
 //! ```
 
+use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -35,6 +39,12 @@ struct Args {
     /// Control rates to measure (Hz).
     #[arg(long, value_delimiter = ',', default_value = "500,1000")]
     rates: Vec<f64>,
+    /// Load conditions to measure at each rate.
+    #[arg(long, value_delimiter = ',', default_value = "idle,busy")]
+    loads: Vec<Load>,
+    /// walkd's busy-wait time around each expected sample (µs), overriding `[runtime] spin_us`.
+    #[arg(long)]
+    spin_us: Option<u32>,
     /// SCHED_FIFO priority for walkd's control thread (degrades with a warning if not
     /// permitted); walk-sim then runs one below it under `chrt -f`, like a real-time adapter.
     #[arg(long)]
@@ -42,6 +52,38 @@ struct Args {
     /// Internal: burn one CPU until killed (the load generator).
     #[arg(long, hide = true)]
     burn: bool,
+}
+
+/// The CPU load during a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Load {
+    /// Nothing but the measured processes.
+    Idle,
+    /// One busy-loop process per CPU.
+    Busy,
+}
+
+impl Load {
+    fn describe(self) -> &'static str {
+        match self {
+            Self::Idle => "idle",
+            Self::Busy => "all CPUs busy",
+        }
+    }
+}
+
+/// What one run measured.
+struct Measurement {
+    /// The daemon's status at the end of the run.
+    status: DaemonStatus,
+    /// Whether the long walk was accepted.
+    walking: bool,
+    /// walkd's timing log lines (timer wake-up lateness, deadline misses).
+    timing_log: Vec<String>,
+    /// The system's 1-minute load average when the run started (other processes included).
+    load_average: String,
+    /// CPU walkd used during the run (100 = one core busy).
+    walkd_cpu_percent: f64,
 }
 
 /// Child processes, killed when dropped.
@@ -84,12 +126,12 @@ fn sibling(name: &str) -> anyhow::Result<PathBuf> {
     Ok(path)
 }
 
-fn spawn(path: &Path, args: &[String]) -> anyhow::Result<Child> {
+fn spawn(path: &Path, args: &[String], stderr: Stdio) -> anyhow::Result<Child> {
     Command::new(path)
         .args(args)
         .stdin(Stdio::null())
         .stdout(Stdio::null())
-        .stderr(Stdio::null())
+        .stderr(stderr)
         .spawn()
         .with_context(|| format!("cannot start {}", path.display()))
 }
@@ -100,7 +142,8 @@ fn start_load() -> anyhow::Result<Children> {
     let me = std::env::current_exe()?;
     let mut load = Children(Vec::new());
     for _ in 0..cores {
-        load.0.push(spawn(&me, &["--burn".to_owned()])?);
+        load.0
+            .push(spawn(&me, &["--burn".to_owned()], Stdio::null())?);
     }
     Ok(load)
 }
@@ -122,13 +165,20 @@ fn long_walk(config: &Path) -> anyhow::Result<String> {
         .to_json_string())
 }
 
-/// Runs walkd + walk-sim at `rate_hz` for `seconds` and returns the daemon's final status.
-fn measure(
-    args: &Args,
-    walk: &str,
-    rate_hz: f64,
-    loaded: bool,
-) -> anyhow::Result<(DaemonStatus, bool)> {
+/// walkd's log lines about its timing (see `daemon::runtime`), without the timestamp.
+fn timing_lines(log: &str) -> Vec<String> {
+    log.lines()
+        .filter(|line| line.contains("timer wake-up lateness") || line.contains("deadline miss"))
+        .map(|line| {
+            line.split_once(": ")
+                .map_or(line, |(_, rest)| rest)
+                .to_owned()
+        })
+        .collect()
+}
+
+/// Runs walkd + walk-sim at `rate_hz` for `seconds` and returns what the daemon measured.
+fn measure(args: &Args, walk: &str, rate_hz: f64, load: Load) -> anyhow::Result<Measurement> {
     let prefix = format!("walk-latency/{}/{}", std::process::id(), rate_hz as u64);
     let common = vec![
         "--config".to_owned(),
@@ -144,19 +194,41 @@ fn measure(
     if let Some(priority) = args.fifo_priority {
         walkd_args.extend(["--fifo-priority".to_owned(), priority.to_string()]);
     }
+    if let Some(spin_us) = args.spin_us {
+        walkd_args.extend(["--spin-us".to_owned(), spin_us.to_string()]);
+    }
     let mut sim_args = common;
     sim_args.extend(["--physics".to_owned(), "kinematic".to_owned()]);
-    let _load = if loaded { Some(start_load()?) } else { None };
-    let mut system = Children(vec![spawn(&sibling("walkd")?, &walkd_args)?]);
+    let load_average = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|text| text.split_whitespace().next().map(str::to_owned))
+        .unwrap_or_else(|| "?".to_owned());
+    let _load = match load {
+        Load::Idle => None,
+        Load::Busy => Some(start_load()?),
+    };
+    let log_path = std::env::temp_dir().join(format!(
+        "latency-report-{}-{}-{}.log",
+        std::process::id(),
+        rate_hz as u64,
+        load.describe().replace(' ', "-")
+    ));
+    let log =
+        File::create(&log_path).with_context(|| format!("cannot create {}", log_path.display()))?;
+    let mut system = Children(vec![spawn(
+        &sibling("walkd")?,
+        &walkd_args,
+        Stdio::from(log),
+    )?]);
     let sim = sibling("walk-sim")?;
     system.0.push(match args.fifo_priority {
         Some(priority) => {
             let mut chrt_args = vec!["-f".to_owned(), (priority - 1).max(1).to_string()];
             chrt_args.push(sim.display().to_string());
             chrt_args.extend(sim_args);
-            spawn(Path::new("chrt"), &chrt_args)?
+            spawn(Path::new("chrt"), &chrt_args, Stdio::null())?
         }
-        None => spawn(&sim, &sim_args)?,
+        None => spawn(&sim, &sim_args, Stdio::null())?,
     });
 
     let names = ServiceNames::new(&prefix)?;
@@ -177,12 +249,46 @@ fn measure(
     let walking = client
         .submit(walk.as_bytes(), Duration::from_secs(10))?
         .accepted;
+    let walkd_pid = system.0[0].id();
+    let (cpu_start, wall_start) = (cpu_seconds(walkd_pid)?, Instant::now());
     std::thread::sleep(Duration::from_secs(args.seconds));
+    let walkd_cpu_percent =
+        100.0 * (cpu_seconds(walkd_pid)? - cpu_start) / wall_start.elapsed().as_secs_f64();
     let status = client
         .control(ControlCommand::Query, Duration::from_secs(5))?
         .status;
     system.terminate();
-    Ok((status, walking))
+    let log = std::fs::read_to_string(&log_path)
+        .with_context(|| format!("cannot read walkd's log {}", log_path.display()))?;
+    let _ = std::fs::remove_file(&log_path);
+    Ok(Measurement {
+        status,
+        walking,
+        timing_log: timing_lines(&log),
+        load_average,
+        walkd_cpu_percent,
+    })
+}
+
+/// CPU time (user + system, all threads) process `pid` used so far, from `/proc/<pid>/stat`.
+fn cpu_seconds(pid: u32) -> anyhow::Result<f64> {
+    let path = format!("/proc/{pid}/stat");
+    let stat = std::fs::read_to_string(&path).with_context(|| format!("cannot read {path}"))?;
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let fields: Vec<&str> = stat
+        .rsplit_once(')')
+        .map_or("", |(_, rest)| rest)
+        .split_whitespace()
+        .collect();
+    let ticks = |index: usize| -> anyhow::Result<f64> {
+        fields
+            .get(index)
+            .and_then(|field| field.parse::<f64>().ok())
+            .with_context(|| format!("{path}: field {} is not a number", index + 3))
+    };
+    // SAFETY: sysconf has no memory-safety preconditions.
+    let ticks_per_second = unsafe { libc::sysconf(libc::_SC_CLK_TCK) } as f64;
+    Ok((ticks(11)? + ticks(12)?) / ticks_per_second)
 }
 
 fn histogram_rows(name: &str, histogram: &LogHistogram) -> String {
@@ -215,28 +321,38 @@ fn main() -> anyhow::Result<()> {
     println!("# walkd latency report\n");
     println!(
         "{} s per run, robot config {}, {} CPU(s); load = one busy-loop process per CPU; \
-         SCHED_FIFO: {}.\n",
+         SCHED_FIFO: {}; walkd spin: {}.\n",
         args.seconds,
         args.config.display(),
         std::thread::available_parallelism().map_or(1, |n| n.get()),
         args.fifo_priority.map_or("off".to_owned(), |p| format!(
             "walkd {p}, walk-sim {}",
             (p - 1).max(1)
-        ))
+        )),
+        args.spin_us
+            .map_or("[runtime] spin_us of the config".to_owned(), |us| format!(
+                "{us} µs"
+            )),
     );
     println!(
-        "| rate | load | walking | ticks | deadline misses | stale periods | tick p50/p99/max (µs) | sensor→command p50/p99/max (µs) | jitter p50/p99/max (µs) | p99 latency − p99 tick (µs) |"
+        "| rate | load | load avg at start | walking | ticks | deadline misses | stale periods | tick p50/p99/max (µs) | sensor→command p50/p99/max (µs) | jitter p50/p99/max (µs) | p99 latency − p99 tick (µs) | walkd CPU |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     let mut details = String::new();
     for &rate in &args.rates {
-        for loaded in [false, true] {
-            let load = if loaded { "all CPUs busy" } else { "idle" };
-            let (s, walking) = measure(&args, &walk, rate, loaded)?;
+        for &load in &args.loads {
+            let Measurement {
+                status: s,
+                walking,
+                timing_log,
+                load_average,
+                walkd_cpu_percent,
+            } = measure(&args, &walk, rate, load)?;
             let triple =
                 |l: &shm_types::LatencySummary| format!("{:.1}/{:.1}/{:.1}", l.p50, l.p99, l.max);
             println!(
-                "| {rate} Hz | {load} | {} ({}) | {} | {} | {} | {} | {} | {} | {:.1} |",
+                "| {rate} Hz | {} | {load_average} | {} ({}) | {} | {} | {} | {} | {} | {} | {:.1} | {walkd_cpu_percent:.0} % |",
+                load.describe(),
                 if walking { "yes" } else { "no" },
                 s.state.name(),
                 s.ticks,
@@ -247,7 +363,7 @@ fn main() -> anyhow::Result<()> {
                 triple(&s.jitter_us),
                 s.latency_us.p99 - s.tick_us.p99,
             );
-            details.push_str(&format!("\n## {rate} Hz, {load}\n\n"));
+            details.push_str(&format!("\n## {rate} Hz, {}\n\n", load.describe()));
             details.push_str(&histogram_rows(
                 "sensor→command latency",
                 &s.latency_histogram,
@@ -256,6 +372,12 @@ fn main() -> anyhow::Result<()> {
             details.push_str(&histogram_rows("tick jitter", &s.jitter_histogram));
             details.push('\n');
             details.push_str(&histogram_rows("tick compute time", &s.tick_histogram));
+            details.push_str("\nwalkd's timing log (µs; a miss: timer wake-up lateness, sample stamp − expected, stamp → picked up, tick, command after deadline):\n\n```text\n");
+            for line in &timing_log {
+                details.push_str(line);
+                details.push('\n');
+            }
+            details.push_str("```\n");
         }
     }
     println!("{details}");

@@ -4,8 +4,13 @@
 //! min  Σ_k w_k ‖J_k ν − v*_k‖² + λ‖ν‖²        v*_k = feed-forward + K_k · error_k
 //! s.t. J_c ν = 0                               feet in contact
 //!      n_eᵀ J_com,xy ν ≤ k_s (d_e − m − n_eᵀ c) CoM stays in the support polygon shrunk by m
-//!      q̇ within velocity limits and (q_min + margin − q)/dt ≤ q̇ ≤ (q_max − margin − q)/dt
+//!      q̇ within velocity limits and (q_min + margin − q_cmd)/dt ≤ q̇ ≤ (q_max − margin − q_cmd)/dt
 //! ```
+//!
+//! The position limits act on `q_cmd`, the joint command the controller integrates (the servos
+//! track it), not on the measured angle: bounding the measured angle with a one-tick (1/dt)
+//! correction would feed the servo's tracking lag back into the integrated command and make a
+//! joint resting at its bound oscillate.
 //!
 //! Tasks: CoM x/y, end-effector poses, upright base, posture. Jacobian blocks are accumulated
 //! over their structurally non-zero columns only, so a foot task costs a few hundred flops.
@@ -94,7 +99,8 @@ impl QpAssembler {
         &self.problem
     }
 
-    /// Fills the QP for this tick. `kinematics` must be updated at `configuration`.
+    /// Fills the QP for this tick. `kinematics` must be updated at `configuration`;
+    /// `command` is the last joint command (the integrator the solution advances).
     #[allow(clippy::too_many_arguments)]
     pub fn assemble(
         &mut self,
@@ -102,6 +108,7 @@ impl QpAssembler {
         config: &ControllerConfig,
         kinematics: &Kinematics,
         configuration: &Configuration,
+        command: &DVector<f64>,
         targets: &Targets,
         posture: &DVector<f64>,
         dt: f64,
@@ -151,7 +158,9 @@ impl QpAssembler {
             kinematics.frame_jacobian(model, frame, &mut self.jacobian);
             let pose = kinematics.frame_pose(model, frame);
             let desired = pose_velocity(&pose, &target, config.pose_gain);
-            let weight = if e.is_foot() {
+            let weight = if targets.unloading == Some(e) {
+                config.unload_foot_weight
+            } else if e.is_foot() {
                 config.foot_weight
             } else {
                 config.hand_weight
@@ -234,7 +243,7 @@ impl QpAssembler {
         }
         for (j, limit) in model.joint_limits().iter().enumerate() {
             let speed = config.velocity_limit_scale * limit.velocity;
-            let qj = configuration.joints[j];
+            let qj = command[j];
             let lower = (-speed).max((limit.lower + config.joint_limit_margin_rad - qj) / dt);
             let upper = speed.min((limit.upper - config.joint_limit_margin_rad - qj) / dt);
             // Outside the margin the bound pulls back inside; never cross the bounds.

@@ -82,6 +82,17 @@ pub struct ControllerConfig {
     pub phase_timeout_s: f64,
     /// Longest step between consecutive contacts of one foot that a sequence may ask for (m).
     pub max_step_m: f64,
+    /// How far the integrated joint command may lead the measured angle (rad). The command is
+    /// integrated from the previous command, so a loaded joint keeps the servo offset that holds
+    /// its load; this bound stops the integral from winding up when a joint is blocked.
+    pub command_lead_max_rad: f64,
+    /// Task weight of a foot while it unloads: out of the contact set but still on the ground,
+    /// so it must rise straight up rather than slide (usually well above `foot_weight`).
+    pub unload_foot_weight: f64,
+    /// The robot is tipping when the IMU's base orientation and the leg-odometry estimate differ
+    /// by more than this angle (rad): the stance feet are no longer flat on the ground. Only
+    /// checked when the measurement has an IMU.
+    pub tipping_detection_rad: f64,
 }
 
 impl Default for ControllerConfig {
@@ -123,6 +134,9 @@ impl Default for ControllerConfig {
             touchdown_debounce_ticks: 3,
             phase_timeout_s: 5.0,
             max_step_m: 0.5,
+            command_lead_max_rad: 0.05,
+            unload_foot_weight: 100.0,
+            tipping_detection_rad: 0.25,
         }
     }
 }
@@ -242,6 +256,9 @@ impl ControllerConfig {
             ),
             ("phase_timeout_s", self.phase_timeout_s),
             ("max_step_m", self.max_step_m),
+            ("command_lead_max_rad", self.command_lead_max_rad),
+            ("unload_foot_weight", self.unload_foot_weight),
+            ("tipping_detection_rad", self.tipping_detection_rad),
         ];
         let non_negative = [
             ("joint_limit_margin_rad", self.joint_limit_margin_rad),

@@ -1,5 +1,12 @@
 //! Floating-base estimation by leg odometry: the feet in contact are anchored in the world, so the
-//! base pose follows from the measured joint angles; an IMU, when present, gives the orientation.
+//! base pose follows from the measured joint angles.
+//!
+//! An IMU, when present, sets the initial orientation only. While walking the orientation comes
+//! from the anchored feet too: the QP holds those feet at their anchors, and an estimate that saw
+//! a stance foot tipped (the IMU's view when a compliant foot rolls a little on its edge) would
+//! make the anchor correction turn the joints to flatten the foot, which rolls the robot further
+//! the same way. Measured under MuJoCo: with the IMU orientation JVRC-1 toppled in 3 of 3 5 m
+//! walks, with leg odometry alone it finished all three.
 
 use kinematics::configuration::Configuration;
 use kinematics::kinematics::Kinematics;
@@ -61,14 +68,13 @@ impl BaseEstimator {
         configuration: &mut Configuration,
         anchors: [Option<&Isometry3<f64>>; 2],
         weights: [f64; 2],
-        imu: Option<UnitQuaternion<f64>>,
     ) -> bool {
         configuration.base = self.base;
         kinematics.update(&robot.model, configuration);
         let inverse_base = self.base.inverse();
         let mut total_weight = 0.0;
         let mut translation = Vector3::zeros();
-        let mut rotation: Option<UnitQuaternion<f64>> = imu;
+        let mut rotation: Option<UnitQuaternion<f64>> = None;
         for (slot, foot) in [EndEffector::LeftFoot, EndEffector::RightFoot]
             .iter()
             .enumerate()
@@ -80,18 +86,11 @@ impl BaseEstimator {
                 inverse_base * kinematics.frame_pose(&robot.model, robot.frame(*foot));
             let candidate = anchor * foot_in_base.inverse();
             let weight = weights[slot].max(1e-6);
-            if imu.is_none() {
-                rotation = Some(match rotation {
-                    None => candidate.rotation,
-                    Some(r) => r.nlerp(&candidate.rotation, weight / (total_weight + weight)),
-                });
-            }
-            let t = match imu {
-                // With the IMU orientation fixed, the foot gives the translation alone.
-                Some(r) => anchor.translation.vector - r * foot_in_base.translation.vector,
-                None => candidate.translation.vector,
-            };
-            translation += weight * t;
+            rotation = Some(match rotation {
+                None => candidate.rotation,
+                Some(r) => r.nlerp(&candidate.rotation, weight / (total_weight + weight)),
+            });
+            translation += weight * candidate.translation.vector;
             total_weight += weight;
         }
         let Some(rotation) = rotation.filter(|_| total_weight > 0.0) else {

@@ -47,6 +47,8 @@ pub(crate) struct Targets {
     pub com_velocity: Vector2<f64>,
     /// Pose tasks (None: no task; feet in contact are constrained instead).
     pub end_effectors: [Option<PoseTarget>; 4],
+    /// The foot being unloaded: out of the contact set but still on the ground.
+    pub unloading: Option<EndEffector>,
 }
 
 /// Result of one state-machine update.
@@ -117,6 +119,7 @@ impl StateMachine {
                 com: Vector2::zeros(),
                 com_velocity: Vector2::zeros(),
                 end_effectors: [None; 4],
+                unloading: None,
             },
         }
     }
@@ -506,6 +509,8 @@ impl StateMachine {
         } else {
             None
         };
+        self.targets.unloading =
+            moving.filter(|_| self.started && self.current_step().phase == Phase::Unload);
         for e in EndEffector::ALL {
             let i = e as usize;
             self.targets.end_effectors[i] = if Some(e) == moving {

@@ -6,11 +6,15 @@
 //!
 //! Each executing tick:
 //! 1. checks the measurement (sizes, finite values);
-//! 2. estimates the floating base from the feet in contact (leg odometry, IMU orientation if any);
+//! 2. estimates the floating base from the feet in contact (leg odometry);
 //! 3. advances the state machine ([`Phase`]s per transition; contact changes confirmed by FT);
 //! 4. builds the QP (CoM x/y, end-effector, upright and posture tasks; contact, support polygon,
 //!    joint position and velocity constraints) and solves it with the chosen back-end;
-//! 5. writes `q_des = q + q̇·dt` clamped inside the joint limits, `qd_des = q̇`.
+//! 5. integrates the joint command from the previous one, `q_des ← q_des + q̇·dt`, kept within
+//!    `command_lead_max_rad` of the measured angle and inside the joint limits; `qd_des = q̇`.
+//!    Integrating from the command rather than from the measurement keeps the servo offset that
+//!    holds a loaded joint against gravity (a position-controlled joint commanded to where it
+//!    already is exerts no torque).
 //!
 //! A failed solve, an invalid measurement or a phase timeout holds the last safe command and
 //! enters [`ControllerState::Fault`].
@@ -71,7 +75,8 @@ pub struct Measurement<'a> {
     /// Force xyz and torque xyz at the FT frames, by `EndEffector` (LF, RF, LH, RH), in
     /// world-aligned axes at the sensor frame origin: the force the environment exerts on the robot.
     pub wrenches: &'a [[f64; 6]; 4],
-    /// Base orientation if the adapter has an IMU.
+    /// Base orientation if the adapter has an IMU (sets up the world frame on the first tick;
+    /// leg odometry estimates the base afterwards, see `estimator`).
     pub imu_orientation: Option<UnitQuaternion<f64>>,
 }
 
@@ -126,7 +131,7 @@ pub struct Controller {
     assembler: QpAssembler,
     solution: Vec<f64>,
     poses: [Isometry3<f64>; 4],
-    hold_q: DVector<f64>,
+    last_command: DVector<f64>,
     world_ready: bool,
     status: ControllerStatus,
 }
@@ -158,7 +163,7 @@ impl Controller {
             assembler: QpAssembler::new(&robot),
             solution: vec![0.0; nv],
             poses: [Isometry3::identity(); 4],
-            hold_q: robot.standing.joints.clone(),
+            last_command: robot.standing.joints.clone(),
             world_ready: false,
             status: ControllerStatus::default(),
             solver,
@@ -212,6 +217,11 @@ impl Controller {
             self.write_hold(out);
             return;
         }
+        if self.tipping(measurement) {
+            self.enter_fault(FaultCode::Tipping);
+            self.write_hold(out);
+            return;
+        }
         if self.status.state != ControllerState::Executing {
             self.write_hold(out);
             return;
@@ -224,8 +234,8 @@ impl Controller {
         match self.machine.update(&feedback, dt) {
             Progress::Running => {}
             Progress::Done => {
+                // Keep holding the last command: it carries the servo offsets of the load.
                 self.status.state = ControllerState::Done;
-                self.hold_q.copy_from_slice(measurement.q);
                 self.publish_progress();
                 self.write_hold(out);
                 return;
@@ -246,6 +256,7 @@ impl Controller {
             &self.config,
             &self.kinematics,
             &self.configuration,
+            &self.last_command,
             self.machine.targets(),
             posture,
             dt,
@@ -275,13 +286,13 @@ impl Controller {
         self.hold();
     }
 
-    /// RT: holds the current posture (→ Holding), from any state except a fault.
+    /// RT: holds the last command (→ Holding), from any state except a fault. The last command
+    /// rather than the measured posture, so loaded joints keep their holding torque.
     pub fn hold(&mut self) {
         if self.status.state == ControllerState::Fault {
             return;
         }
         self.machine.stop();
-        self.hold_q.copy_from(&self.configuration.joints);
         self.status.state = ControllerState::Holding;
         self.status.phase = Phase::None;
     }
@@ -337,7 +348,7 @@ impl Controller {
         );
         self.update_poses();
         self.machine.set_standing(standing, &self.poses);
-        self.hold_q.copy_from_slice(measurement.q);
+        self.last_command.copy_from_slice(measurement.q);
         self.world_ready = true;
     }
 
@@ -353,7 +364,6 @@ impl Controller {
             &mut self.configuration,
             self.machine.foot_anchors(),
             weights,
-            measurement.imu_orientation,
         );
         self.update_poses();
         let com = self.kinematics.com();
@@ -362,6 +372,14 @@ impl Controller {
         self.status.right_foot = pose_array(&self.poses[EndEffector::RightFoot as usize]);
         self.status.contacts = self.machine.targets().contacts;
         ok
+    }
+
+    /// The IMU sees the base turned away from where leg odometry puts it: the anchored feet are
+    /// no longer flat on the ground.
+    fn tipping(&self, measurement: &Measurement) -> bool {
+        measurement.imu_orientation.is_some_and(|imu| {
+            imu.angle_to(&self.configuration.base.rotation) > self.config.tipping_detection_rad
+        })
     }
 
     fn update_poses(&mut self) {
@@ -389,14 +407,16 @@ impl Controller {
         self.status.fault = code;
     }
 
-    /// Holds `hold_q` (the last safe command or the posture at hold time).
+    /// Holds `last_command`: the last command written (the measured posture before the first one).
     fn write_hold(&self, out: &mut Command) {
-        out.q_des.copy_from(&self.hold_q);
+        out.q_des.copy_from(&self.last_command);
         out.qd_des.fill(0.0);
         out.mode = CommandMode::Hold;
     }
 
-    /// `q_des = q + q̇·dt` inside the joint limits; non-finite → fault and hold.
+    /// Integrates `q_des ← q_des + q̇·dt` from the last command (`last_command`), within
+    /// `command_lead_max_rad` of the measured angle and inside the joint limits; non-finite →
+    /// fault and hold.
     fn write_track(&mut self, measurement: &Measurement, dt: f64, out: &mut Command) {
         let limits = self.robot.model.joint_limits();
         let qd = &self.solution[6..];
@@ -405,13 +425,18 @@ impl Controller {
             self.write_hold(out);
             return;
         }
+        let lead = self.config.command_lead_max_rad;
         for (j, limit) in limits.iter().enumerate() {
-            let q = (measurement.q[j] + qd[j] * dt).clamp(limit.lower, limit.upper);
+            let measured = measurement.q[j];
+            let previous = self.last_command[j];
+            let q = (previous + qd[j] * dt)
+                .clamp(measured - lead, measured + lead)
+                .clamp(limit.lower, limit.upper);
             out.q_des[j] = q;
-            out.qd_des[j] = (q - measurement.q[j]) / dt;
+            out.qd_des[j] = (q - previous) / dt;
         }
         out.mode = CommandMode::Track;
-        self.hold_q.copy_from(&out.q_des);
+        self.last_command.copy_from(&out.q_des);
     }
 }
 

@@ -83,6 +83,9 @@ pub enum FaultCode {
     NonFiniteCommand,
     /// No foot in contact to estimate the floating base from.
     LostSupport,
+    /// The IMU and leg odometry disagree about the base orientation by more than
+    /// `tipping_detection_rad`: the robot is rolling over a sole edge (a fall in progress).
+    Tipping,
     /// A phase did not reach its target within its planned duration plus the timeout.
     Timeout(Phase),
 }
@@ -97,6 +100,7 @@ impl FaultCode {
             Self::QpFailed => "QP solver failed",
             Self::NonFiniteCommand => "non-finite command",
             Self::LostSupport => "no foot in contact",
+            Self::Tipping => "tipping: IMU and leg odometry disagree on the base orientation",
             Self::Timeout(Phase::ShiftCom) => "timeout: CoM shift did not reach its target",
             Self::Timeout(Phase::Unload) => {
                 "timeout: foot force did not drop below the release threshold"
@@ -119,6 +123,7 @@ impl FaultCode {
             Self::QpFailed => "qp_failed",
             Self::NonFiniteCommand => "non_finite_command",
             Self::LostSupport => "lost_support",
+            Self::Tipping => "tipping",
             Self::Timeout(Phase::ShiftCom) => "timeout_shift_com",
             Self::Timeout(Phase::Unload) => "timeout_unload",
             Self::Timeout(Phase::Lift) => "timeout_lift",

@@ -4,7 +4,10 @@
 //! CLOCK_MONOTONIC) aligned so that the adapter's samples, by their timestamps, fall mid-period.
 //! Each period it sleeps until the period starts (never ticking early, so it never bursts),
 //! waits for a sample stamped in this period until the period ends, ticks and sends the
-//! command. Deadline accounting:
+//! command. With a spin time (`[runtime] spin_us`) it sleeps instead until `spin` before the
+//! expected sample and busy-polls shared memory for it until `spin` after, so neither a
+//! cross-process wake-up nor a late timer wake-up of up to `spin` lies between the sample and
+//! the command; only then (adapter late) it blocks on the sample event. Deadline accounting:
 //! - a command sent after the end of its sample's period is a deadline miss, and so is every
 //!   period the overrun swallowed; the grid then continues with the first period that has not
 //!   ended (no catching up);
@@ -30,13 +33,17 @@ use shm_types::{
 
 use super::shared::{Shared, StartOutcome};
 use super::snapshot::SnapshotWriter;
-use super::stats::{LoopStats, log_histogram, record, summarize};
+use super::stats::{LoopStats, MissRecord, log_histogram, record, summarize};
 use crate::controller::{
     Command, CommandMode, Controller, ControllerState, FaultCode, Measurement, PreparedSequence,
 };
 
 /// Longest single blocking wait, so stop requests and submissions are seen quickly.
 const MAX_WAIT: Duration = Duration::from_millis(20);
+
+/// Shortest blocking wait: the event's socket timeout has µs resolution, and a timeout that
+/// rounds to 0 would block until the next notification.
+const MIN_WAIT: Duration = Duration::from_micros(1);
 
 /// Timing of the control loop.
 #[derive(Debug, Clone, Copy)]
@@ -51,6 +58,19 @@ pub struct LoopTiming {
     pub lockstep_timeout_ns: u64,
     /// Interval between status snapshots.
     pub status_interval_ns: u64,
+    /// Realtime: busy-poll for the sample from this long before until this long after its
+    /// expected time (0: sleep until the period starts and block on the sample event). At
+    /// most half a period is used.
+    pub spin_ns: u64,
+}
+
+/// When a tick's work was done.
+#[derive(Debug, Clone, Copy)]
+struct TickTimes {
+    /// The controller's command was computed.
+    computed_ns: u64,
+    /// The command was sent.
+    sent_ns: u64,
 }
 
 /// The control thread's state.
@@ -62,6 +82,8 @@ pub struct ControlLoop {
     timing: LoopTiming,
     dof: usize,
     sample: SensorSample,
+    /// When the loop took `sample` from the subscriber.
+    sample_taken_ns: u64,
     command: Command,
     command_seq: u64,
     stats: LoopStats,
@@ -98,6 +120,7 @@ impl ControlLoop {
             timing,
             dof,
             sample: SensorSample::ZERO,
+            sample_taken_ns: 0,
             command: Command::new(dof),
             command_seq: 0,
             stats: LoopStats::new(),
@@ -134,6 +157,8 @@ impl ControlLoop {
 
     fn run_realtime(&mut self) -> Result<(), ShmError> {
         let period = self.timing.period_ns;
+        let spin = self.timing.spin_ns.min(period / 2);
+        let loop_start = monotonic_ns();
         // `start` is the beginning of the current period; samples are expected at its middle.
         let mut start: Option<u64> = None;
         while !self.stopping() {
@@ -148,9 +173,19 @@ impl ControlLoop {
                 }
                 continue;
             };
-            sleep_until(period_start);
-            let (mut period_start, mut end) = (period_start, period_start + period);
-            let fresh = self.wait_for_current_sample(period_start, end)?;
+            let mut end = period_start + period;
+            let mut expected = period_start + period / 2;
+            let wake_at = if spin > 0 {
+                expected - spin
+            } else {
+                period_start
+            };
+            sleep_until(wake_at);
+            let wake_late = monotonic_ns().saturating_sub(wake_at);
+            record(&mut self.stats.wakeup, wake_late);
+            let fresh = (spin > 0
+                && self.spin_for_current_sample(period_start, expected + spin)?)
+                || self.wait_for_current_sample(period_start, end)?;
             let now = if fresh {
                 let stamped = self.sample.timestamp_ns;
                 if stamped >= end {
@@ -158,19 +193,28 @@ impl ControlLoop {
                     // the periods before it went without a sample; answer it in its own period.
                     let skipped = (stamped - period_start) / period;
                     self.stats.stale_periods += skipped;
-                    period_start += skipped * period;
                     end += skipped * period;
+                    expected += skipped * period;
                 }
-                let expected = period_start + period / 2;
                 let tick_start = monotonic_ns();
                 record(&mut self.stats.jitter, tick_start.abs_diff(expected));
-                self.tick(tick_start)?;
-                let now = monotonic_ns();
-                if now > end {
+                let times = self.tick(tick_start)?;
+                if times.sent_ns > end {
                     // Our command is late, and every period we overran stays unanswered.
-                    self.stats.deadline_misses += 1 + (now - end) / period;
+                    let late = times.sent_ns - end;
+                    self.stats.deadline_misses += 1 + late / period;
+                    let miss = MissRecord {
+                        at_ns: tick_start - loop_start,
+                        wake_late_ns: wake_late,
+                        sample_offset_ns: stamped as i64 - expected as i64,
+                        pickup_ns: self.sample_taken_ns.saturating_sub(stamped),
+                        tick_ns: times.computed_ns - tick_start,
+                        late_ns: late,
+                    };
+                    self.stats.miss_causes.count(miss.cause());
+                    self.stats.misses.push(miss);
                 }
-                now
+                monotonic_ns()
             } else {
                 self.stale_period();
                 let now = monotonic_ns();
@@ -185,7 +229,6 @@ impl ControlLoop {
             } else {
                 end
             };
-            let expected = period_start + period / 2;
             start = if self.link == LinkState::Stale {
                 None
             } else if fresh && self.sample.timestamp_ns.abs_diff(expected) > period / 4 {
@@ -196,6 +239,23 @@ impl ControlLoop {
             };
         }
         Ok(())
+    }
+
+    /// Busy-polls shared memory until `until` for a sample taken in this period (stamped at or
+    /// after `start`); older ones are dropped as in [`Self::wait_for_current_sample`]. No
+    /// system call: the subscriber reads shared memory and the clock is read through the vDSO.
+    fn spin_for_current_sample(&mut self, start: u64, until: u64) -> Result<bool, ShmError> {
+        loop {
+            if self.ports.take_latest_sample(&mut self.sample)? {
+                self.sample_taken_ns = monotonic_ns();
+                if self.sample.timestamp_ns >= start {
+                    return Ok(true);
+                }
+            } else if monotonic_ns() >= until {
+                return Ok(false);
+            }
+            std::hint::spin_loop();
+        }
     }
 
     /// Waits until `end` for a sample taken in this period (stamped at or after `start`). An
@@ -244,24 +304,26 @@ impl ControlLoop {
     fn wait_for_sample_until(&mut self, deadline_ns: u64) -> Result<bool, ShmError> {
         loop {
             if self.ports.take_latest_sample(&mut self.sample)? {
+                self.sample_taken_ns = monotonic_ns();
                 return Ok(true);
             }
             let now = monotonic_ns();
             if now >= deadline_ns || self.stopping() {
                 return Ok(false);
             }
-            let wait = Duration::from_nanos(deadline_ns - now).min(MAX_WAIT);
+            // At least 1 µs: the socket timeout has µs resolution and 0 would mean "forever".
+            let wait = Duration::from_nanos(deadline_ns - now).clamp(MIN_WAIT, MAX_WAIT);
             if !self.ports.wait_for_sample(wait)? {
                 self.housekeeping();
             }
         }
     }
 
-    /// One control step on `self.sample`.
-    fn tick(&mut self, tick_start: u64) -> Result<(), ShmError> {
+    /// One control step on `self.sample`. Between taking the sample and sending the command
+    /// only the controller runs; submissions, control requests and the status come after.
+    fn tick(&mut self, tick_start: u64) -> Result<TickTimes, ShmError> {
         self.link = LinkState::Fresh;
         self.stale_in_row = 0;
-        self.housekeeping();
         let n = (self.sample.joint_count as usize).min(self.sample.q.len());
         let imu = self.sample.has_imu.then(|| {
             let [x, y, z, w] = self.sample.imu_orientation;
@@ -275,20 +337,24 @@ impl ControlLoop {
         };
         let dt = self.timing.period_ns as f64 * 1e-9;
         self.controller.tick(&measurement, dt, &mut self.command);
-        let computed = monotonic_ns();
-        record(&mut self.stats.tick, computed - tick_start);
-        self.stats.ticks += 1;
+        let computed_ns = monotonic_ns();
         self.send_command()?;
-        let sent = monotonic_ns();
+        let sent_ns = monotonic_ns();
+        record(&mut self.stats.tick, computed_ns - tick_start);
         record(
             &mut self.stats.latency,
-            sent.saturating_sub(self.sample.timestamp_ns),
+            sent_ns.saturating_sub(self.sample.timestamp_ns),
         );
+        self.stats.ticks += 1;
         self.note_state_change();
-        if sent >= self.next_status_ns {
+        self.housekeeping();
+        if sent_ns >= self.next_status_ns {
             self.write_status(self.daemon_state());
         }
-        Ok(())
+        Ok(TickTimes {
+            computed_ns,
+            sent_ns,
+        })
     }
 
     fn send_command(&mut self) -> Result<(), ShmError> {
@@ -337,8 +403,10 @@ impl ControlLoop {
         self.write_status(self.daemon_state());
     }
 
-    /// Handles control commands and submissions, and hands freed sequences out.
+    /// Handles control commands and submissions, hands freed sequences out and shows the
+    /// service thread that this thread is alive.
     fn housekeeping(&mut self) {
+        self.shared.beat(monotonic_ns());
         if let Some(sequence) = self.release_later.take() {
             self.release(sequence);
         }

@@ -67,6 +67,9 @@ pub struct DaemonArgs {
     /// Skip `mlockall` even if `[runtime] lock_memory = true`.
     #[arg(long)]
     pub no_lock_memory: bool,
+    /// Busy-wait time around each expected sample (µs), overriding `[runtime] spin_us`.
+    #[arg(long)]
+    pub spin_us: Option<u32>,
 }
 
 /// A failure with the exit code it maps to.
@@ -132,6 +135,9 @@ fn load(args: &DaemonArgs) -> Result<Setup, Failure> {
         runtime.cpu = args.cpu;
     }
     runtime.lock_memory &= !args.no_lock_memory;
+    if let Some(spin_us) = args.spin_us {
+        runtime.spin_us = spin_us;
+    }
     let robot =
         Robot::load(config, args.urdf.as_deref()).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
     let controller_config = ControllerConfig::from_config_file(config)
@@ -173,6 +179,7 @@ fn run(args: &DaemonArgs) -> Result<(), Failure> {
         watchdog_periods: runtime.watchdog_periods,
         lockstep_timeout_ns: runtime.lockstep_timeout_ms * 1_000_000,
         status_interval_ns: (1e9 / runtime.status_rate_hz) as u64,
+        spin_ns: u64::from(runtime.spin_us) * 1000,
     };
     let control_thread =
         spawn_control_thread(&names, &runtime, controller, &shared, status_out, timing)?;
@@ -203,6 +210,7 @@ fn run(args: &DaemonArgs) -> Result<(), Failure> {
         .map_err(|e| fail(exit_code::IPC)(e.into()))?;
     served.map_err(|e| fail(exit_code::IPC)(e.into()))?;
     let stats = stats.map_err(|e| fail(exit_code::IPC)(e.into()))?;
+    log_timing(&stats);
     tracing::info!(
         ticks = stats.ticks,
         deadline_misses = stats.deadline_misses,
@@ -213,6 +221,46 @@ fn run(args: &DaemonArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Logs the timer wake-up lateness and how each recorded deadline miss came about, so a
+/// latency report can tell OS wake-up stalls from late samples and long ticks.
+fn log_timing(stats: &stats::LoopStats) {
+    if !stats.wakeup.is_empty() {
+        let us = |ns: u64| ns as f64 / 1000.0;
+        let wakeup = &stats.wakeup;
+        tracing::info!(
+            p50_us = us(wakeup.value_at_quantile(0.5)),
+            p99_us = us(wakeup.value_at_quantile(0.99)),
+            p999_us = us(wakeup.value_at_quantile(0.999)),
+            max_us = us(wakeup.max()),
+            over_100us = wakeup.count_between(100_000, u64::MAX),
+            over_500us = wakeup.count_between(500_000, u64::MAX),
+            over_1ms = wakeup.count_between(1_000_000, u64::MAX),
+            count = wakeup.len(),
+            "timer wake-up lateness"
+        );
+    }
+    if stats.deadline_misses > 0 {
+        let causes = stats.miss_causes;
+        tracing::info!(
+            adapter_late = causes.adapter_late,
+            pickup = causes.pickup,
+            tick = causes.tick,
+            "deadline miss causes (periods with a late command; swallowed periods not included)"
+        );
+    }
+    for miss in stats.misses.records() {
+        tracing::info!(
+            at_s = miss.at_ns as f64 * 1e-9,
+            wake_late_us = miss.wake_late_ns as f64 / 1000.0,
+            sample_offset_us = miss.sample_offset_ns as f64 / 1000.0,
+            pickup_us = miss.pickup_ns as f64 / 1000.0,
+            tick_us = miss.tick_ns as f64 / 1000.0,
+            late_us = miss.late_ns as f64 / 1000.0,
+            "deadline miss"
+        );
+    }
+}
+
 /// Starts the control thread; returns once its ports are open (or failed to open).
 fn spawn_control_thread(
     names: &ServiceNames,
@@ -220,7 +268,7 @@ fn spawn_control_thread(
     controller: Controller,
     shared: &Arc<Shared>,
     status_out: snapshot::SnapshotWriter<DaemonStatus>,
-    timing: LoopTiming,
+    mut timing: LoopTiming,
 ) -> Result<std::thread::JoinHandle<Result<stats::LoopStats, shm_types::ShmError>>, Failure> {
     let (ready_tx, ready_rx) = std::sync::mpsc::channel();
     let names = names.clone();
@@ -229,11 +277,19 @@ fn spawn_control_thread(
     let thread = std::thread::Builder::new()
         .name("walkd-control".to_owned())
         .spawn(move || {
+            realtime::minimize_timer_slack();
             if let Some(cpu) = cpu {
                 realtime::pin_to_cpu(cpu);
             }
-            if let Some(priority) = priority {
-                realtime::set_fifo_priority(priority);
+            let fifo = priority.is_some_and(realtime::set_fifo_priority);
+            if timing.spin_ns > 0 && !fifo {
+                // Under normal scheduling a busy-waiting thread only takes CPU time from the
+                // adapter and everything else (measured: more deadline misses, not fewer).
+                tracing::warn!(
+                    spin_us = timing.spin_ns / 1000,
+                    "spin_us ignored: busy-waiting needs the control thread on SCHED_FIFO (fifo_priority)"
+                );
+                timing.spin_ns = 0;
             }
             let ports = match DaemonLoopPorts::open(&names, "walkd-control") {
                 Ok(ports) => {

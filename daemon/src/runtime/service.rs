@@ -28,6 +28,8 @@ pub struct ServiceLoop {
     status_interval: Duration,
     last_notified_state: Option<DaemonState>,
     last_link: LinkState,
+    /// systemd's watchdog interval (`WATCHDOG_USEC`), if it watches us.
+    watchdog: Option<Duration>,
 }
 
 /// What answering requests needs (separate from the ports that deliver them).
@@ -61,6 +63,7 @@ impl ServiceLoop {
             status_interval: Duration::from_secs_f64(1.0 / status_rate_hz),
             last_notified_state: None,
             last_link: LinkState::Waiting,
+            watchdog: sd_notify::watchdog_enabled(),
         }
     }
 
@@ -94,8 +97,9 @@ impl ServiceLoop {
     pub fn publish_status(&mut self) -> Result<(), ShmError> {
         let status = self.requests.status_in.read();
         self.ports.publish_status(&status)?;
-        let _ = sd_notify::notify(&[sd_notify::NotifyState::Watchdog]);
-        if status.link != self.last_link {
+        self.feed_watchdog();
+        let link_changed = status.link != self.last_link;
+        if link_changed {
             match status.link {
                 LinkState::Stale => tracing::warn!(
                     state = status.state.name(),
@@ -106,7 +110,7 @@ impl ServiceLoop {
             }
             self.last_link = status.link;
         }
-        if self.last_notified_state != Some(status.state) {
+        if link_changed || self.last_notified_state != Some(status.state) {
             self.last_notified_state = Some(status.state);
             let text = format!(
                 "{} (sequence {}, stance {}/{}, adapter {})",
@@ -119,6 +123,19 @@ impl ServiceLoop {
             let _ = sd_notify::notify(&[sd_notify::NotifyState::Status(&text)]);
         }
         Ok(())
+    }
+
+    /// Sends `WATCHDOG=1` if systemd watches us and the control thread went round within half
+    /// the watchdog interval: a stuck control thread stops the feeding and systemd restarts us.
+    fn feed_watchdog(&self) {
+        let Some(interval) = self.watchdog else {
+            return;
+        };
+        let since_beat =
+            shm_types::monotonic_ns().saturating_sub(self.requests.shared.last_beat_ns());
+        if u128::from(since_beat) <= interval.as_nanos() / 2 {
+            let _ = sd_notify::notify(&[sd_notify::NotifyState::Watchdog]);
+        }
     }
 }
 

@@ -51,6 +51,9 @@ pub struct Shared {
     controls_done: AtomicU64,
     /// Main → control thread: shut down.
     pub stop: AtomicBool,
+    /// Control → service thread: when the control loop last went round (CLOCK_MONOTONIC ns),
+    /// so systemd's watchdog is fed only while the control thread is alive.
+    heartbeat_ns: AtomicU64,
 }
 
 impl Shared {
@@ -63,7 +66,18 @@ impl Shared {
             control: AtomicU8::new(0),
             controls_done: AtomicU64::new(0),
             stop: AtomicBool::new(false),
+            heartbeat_ns: AtomicU64::new(shm_types::monotonic_ns()),
         }
+    }
+
+    /// Control thread: the loop goes round (one atomic store).
+    pub fn beat(&self, now_ns: u64) {
+        self.heartbeat_ns.store(now_ns, Ordering::Relaxed);
+    }
+
+    /// Service thread: when the control loop last went round.
+    pub fn last_beat_ns(&self) -> u64 {
+        self.heartbeat_ns.load(Ordering::Relaxed)
     }
 
     /// Control thread: reports how submission `id` went.

@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use daemon::bench::TickObservation;
-use daemon::controller::{Command, Controller, ControllerConfig, Measurement, SolverKind};
+use daemon::bench::{Outcome, TickObservation, WalkOptions, WalkReport, walk};
+use daemon::controller::{Command, Controller, ControllerConfig, Measurement, Phase, SolverKind};
 use kinematic_sim::KinematicSim;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
@@ -125,6 +125,50 @@ pub fn check_tick(o: &TickObservation) {
         "tick {}: non-finite command",
         o.tick
     );
+}
+
+/// Walks `sequence` on the vendored robot `name` at `rate_hz` with [`check_tick`] on every tick
+/// and asserts that it reaches `done` and covers more than half of `distance`; `label` names
+/// the case in failure messages, which also give the stance index and phase it stopped in.
+pub fn assert_walks_to_done(
+    name: &str,
+    sequence: &PostProcessedSequence,
+    solver: SolverKind,
+    rate_hz: f64,
+    distance: f64,
+    label: &str,
+) -> WalkReport {
+    let options = WalkOptions {
+        solver,
+        rate_hz,
+        time_limit_s: 60.0 + 20.0 * sequence.len() as f64,
+    };
+    let mut last = (0, Phase::None);
+    let report = walk(
+        robot(name),
+        controller_config(name),
+        sequence,
+        &options,
+        |o| {
+            last = (o.status.stance_index, o.status.phase);
+            check_tick(o)
+        },
+    )
+    .expect("walk runs");
+    assert_eq!(
+        report.outcome,
+        Outcome::Done,
+        "{label}: stopped at stance {} of {} in phase {:?}: {report:?}",
+        last.0,
+        report.stances,
+        last.1
+    );
+    assert!(
+        report.distance_m > 0.5 * distance,
+        "{label}: walked {} m of {distance} m",
+        report.distance_m
+    );
+    report
 }
 
 /// A controller and the kinematic simulator in closed loop, stepped one tick at a time so tests

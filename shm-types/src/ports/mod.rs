@@ -5,7 +5,9 @@ mod adapter;
 mod client;
 mod daemon;
 mod stream;
+mod truth;
 
 pub use adapter::AdapterPorts;
 pub use client::ClientPorts;
 pub use daemon::{DaemonLoopPorts, DaemonServicePorts};
+pub use truth::{TruthPublisher, TruthSubscriber};

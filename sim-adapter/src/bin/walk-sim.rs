@@ -4,6 +4,9 @@
 //! walk-sim --config configs/armar4.toml --physics kinematic|mujoco [--clock realtime|lockstep]
 //!          [--rate-hz F] [--urdf PATH] [--service-prefix P]
 //! ```
+//! Besides the adapter side of the contract it publishes the simulator's ground truth (CoM,
+//! sole poses, base height and tilt, fall flag) on `<prefix>/sim-truth` with every sample.
+//!
 //! Exit codes: see `shm_types::process::exit_code` (0 clean, 3 config/model, 4 IPC, 1 other).
 
 use std::path::PathBuf;
@@ -15,8 +18,10 @@ use clap::{Parser, ValueEnum};
 use kinematic_sim::SafetySummary;
 use kinematics::robot::Robot;
 use shm_types::process::{exit_code, install_termination_handler, termination_requested};
-use shm_types::{AdapterPorts, ClockMode, RuntimeConfig, ServiceNames};
-use sim_adapter::{AdapterOptions, KinematicRobot, RobotIo, run_adapter};
+use shm_types::{AdapterPorts, ClockMode, RuntimeConfig, ServiceNames, TruthPublisher};
+use sim_adapter::{
+    AdapterOptions, GroundTruth, KinematicRobot, PublishTruth, RobotIo, run_adapter,
+};
 
 /// Simulated robot for walkd: publishes sensor samples, applies joint commands.
 #[derive(Parser)]
@@ -91,9 +96,9 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
     let robot = Arc::new(robot);
     match args.physics {
         Physics::Kinematic => {
-            let mut sim = KinematicRobot::standing(robot)
+            let sim = KinematicRobot::standing(robot)
                 .map_err(|e| config_error(anyhow::Error::from(e).context("standing posture")))?;
-            serve(&runtime, args.clock, &mut sim, |sim| *sim.summary())
+            serve(&runtime, args.clock, sim, |sim| *sim.summary())
         }
         Physics::Mujoco => serve_mujoco(robot, &runtime, args.clock),
     }
@@ -108,13 +113,13 @@ fn serve_mujoco(
 ) -> Result<(), (u8, anyhow::Error)> {
     use sim_adapter::mujoco::{MujocoOptions, MujocoRobot};
     let urdf = robot.urdf.clone();
-    let mut sim = MujocoRobot::standing(robot, &urdf, MujocoOptions::default()).map_err(|e| {
+    let sim = MujocoRobot::standing(robot, &urdf, MujocoOptions::default()).map_err(|e| {
         (
             exit_code::CONFIG,
             anyhow::Error::from(e).context("MuJoCo model"),
         )
     })?;
-    serve(runtime, clock, &mut sim, |sim| *sim.summary())
+    serve(runtime, clock, sim, |sim| *sim.summary())
 }
 
 /// `--physics mujoco` in a build without the backend: says how to get it.
@@ -127,21 +132,27 @@ fn serve_mujoco(
     Err((
         exit_code::CONFIG,
         anyhow::anyhow!(
-            "built without MuJoCo: run scripts/setup-mujoco.sh and build with --features sim-adapter/mujoco"
+            "walk-sim was built without MuJoCo: run `eval \"$(scripts/setup-mujoco.sh)\"`, then rebuild \
+             it with `cargo build --release -p sim-adapter --features mujoco` (or a workspace build \
+             with `--features sim-adapter/mujoco`)"
         ),
     ))
 }
 
-/// Runs the adapter loop for `sim` until terminated; logs the simulator's safety summary.
-fn serve<R: RobotIo>(
+/// Runs the adapter loop for `sim` until terminated, publishing its ground truth with every
+/// sample; logs the simulator's safety summary.
+fn serve<R: RobotIo + GroundTruth>(
     runtime: &RuntimeConfig,
     clock: ClockMode,
-    sim: &mut R,
+    sim: R,
     summary: impl Fn(&R) -> SafetySummary,
 ) -> Result<(), (u8, anyhow::Error)> {
     let names =
         ServiceNames::new(&runtime.service_prefix).map_err(|e| (exit_code::IPC, e.into()))?;
     let ports = AdapterPorts::open(&names, "walk-sim").map_err(|e| (exit_code::IPC, e.into()))?;
+    let truth =
+        TruthPublisher::open(&names, "walk-sim-truth").map_err(|e| (exit_code::IPC, e.into()))?;
+    let mut sim = PublishTruth::new(sim, truth);
     install_termination_handler();
     let options = AdapterOptions {
         clock,
@@ -155,9 +166,9 @@ fn serve<R: RobotIo>(
         rate_hz = runtime.rate_hz,
         "walk-sim running"
     );
-    let report = run_adapter(&ports, sim, &options, &termination_requested)
+    let report = run_adapter(&ports, &mut sim, &options, &termination_requested)
         .map_err(|e| (exit_code::IPC, e.into()))?;
-    let safety = summary(sim);
+    let safety = summary(sim.robot());
     tracing::info!(
         samples = report.samples,
         commands = report.commands,

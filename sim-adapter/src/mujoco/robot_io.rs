@@ -4,12 +4,13 @@ use std::path::Path;
 use std::sync::Arc;
 
 use kinematic_sim::SafetySummary;
-use kinematics::robot::Robot;
-use shm_types::SensorSample;
+use kinematics::robot::{EndEffector, Robot};
+use shm_types::{SensorSample, SimTruth};
 
 use super::{MujocoError, MujocoOptions, MujocoSim};
 use crate::RobotIo;
 use crate::robot_io::fill_sample;
+use crate::truth::{GroundTruth, pose_array};
 
 /// The MuJoCo simulator as a robot: joint servos under rigid-body dynamics, foot FT from the
 /// contact forces, an IMU on the base.
@@ -55,5 +56,19 @@ impl RobotIo for MujocoRobot {
 
     fn write(&mut self, q_des: &[f64], qd_des: &[f64], dt: f64) -> Result<(), MujocoError> {
         self.sim.step(q_des, qd_des, dt)
+    }
+}
+
+impl GroundTruth for MujocoRobot {
+    /// The physics state's CoM, sole sites and `base_link`; fallen = [`MujocoSim::has_fallen`]
+    /// at any step so far (base below its height fraction or tilted beyond `fall_tilt`).
+    fn ground_truth(&mut self, out: &mut SimTruth) {
+        let sim = &self.sim;
+        out.com = sim.measurement().com.into();
+        out.left_foot = pose_array(&sim.end_effector_pose(EndEffector::LeftFoot));
+        out.right_foot = pose_array(&sim.end_effector_pose(EndEffector::RightFoot));
+        out.base_height_m = sim.base_height();
+        out.tilt_rad = sim.torso_tilt();
+        out.fallen = sim.summary().fell;
     }
 }

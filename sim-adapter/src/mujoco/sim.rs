@@ -183,8 +183,7 @@ impl MujocoSim {
 
     /// Angle between the `base_link` z axis and the world vertical (rad).
     pub fn torso_tilt(&self) -> f64 {
-        let up = self.base_link_pose().rotation * Vector3::z();
-        up.z.clamp(-1.0, 1.0).acos()
+        crate::truth::tilt(&self.base_link_pose())
     }
 
     /// Whether the robot has fallen: the base dropped below `fall_height_fraction` of its initial

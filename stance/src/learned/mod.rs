@@ -3,7 +3,8 @@
 //! into stances with taxonomy labels ([`mod@segment`]), an n-gram model over stance tokens
 //! ([`model`]) with a hand-support part ([`hands`]), its query by distance and affordances
 //! ([`query`]), retargeting of the generated stances to a robot ([`retarget`]), realism
-//! statistics ([`realism`]) and the paper's Fig. 4 ([`coverage`]). See `docs/learning.md`.
+//! statistics ([`realism`]), the paper's Fig. 4 ([`coverage`]) and the source choice shared by
+//! the commands that generate ([`source`]). See `docs/learning.md`.
 
 pub mod c3d;
 mod cluster;
@@ -17,6 +18,7 @@ pub mod query;
 pub mod realism;
 pub mod retarget;
 pub mod segment;
+pub mod source;
 
 pub use demo::{Demonstration, EventKind, GaitEvent, load_folder};
 pub use error::LearnError;
@@ -25,3 +27,4 @@ pub use query::{Generated, Query, Search, generate_tokens};
 pub use realism::{Distribution, WalkStatistics};
 pub use retarget::{LearnedOptions, Retargeted, generate_learned};
 pub use segment::{Keyframe, SegmentOptions, Segmentation, foot_events, segment, taxonomy_label};
+pub use source::{SourceArgs, SourceError, SourceKind, Sourced, StanceSource};

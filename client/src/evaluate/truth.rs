@@ -1,0 +1,202 @@
+//! The simulator's ground truth during a run: recorded from `walk-sim`'s `sim-truth` service on a
+//! thread of its own (a lockstep run publishes thousands of states per second, more than a
+//! subscriber buffers between two daemon statuses), then paired with the daemon's statuses and
+//! turned into the simulator's verdict (fall, tilt, final state).
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use anyhow::Context;
+use shm_types::{ServiceNames, SimTruth, TruthSubscriber};
+
+/// How often the recorder drains the subscriber.
+const DRAIN_PERIOD: Duration = Duration::from_micros(500);
+
+/// Records every state `walk-sim` publishes on a prefix until [`TruthRecorder::finish`].
+pub(crate) struct TruthRecorder {
+    stop: Arc<AtomicBool>,
+    handle: JoinHandle<anyhow::Result<Vec<SimTruth>>>,
+}
+
+impl TruthRecorder {
+    /// Subscribes to `<prefix>/sim-truth`; returns once the subscription exists, so every state
+    /// published afterwards is recorded.
+    pub(crate) fn start(prefix: &str) -> anyhow::Result<Self> {
+        let names = ServiceNames::new(prefix)?;
+        let stop = Arc::new(AtomicBool::new(false));
+        let stopped = Arc::clone(&stop);
+        let (ready, subscribed) = std::sync::mpsc::channel();
+        let handle = std::thread::spawn(move || {
+            // iceoryx2 ports stay on the thread that created them.
+            let subscriber = match TruthSubscriber::open(&names, "walkctl-evaluate-truth") {
+                Ok(subscriber) => {
+                    let _ = ready.send(None);
+                    subscriber
+                }
+                Err(error) => {
+                    let _ = ready.send(Some(error.to_string()));
+                    anyhow::bail!("{error}");
+                }
+            };
+            let mut states = Vec::new();
+            loop {
+                let last_round = stopped.load(Ordering::Relaxed);
+                subscriber.drain(|truth| states.push(*truth))?;
+                if last_round {
+                    return Ok(states);
+                }
+                std::thread::sleep(DRAIN_PERIOD);
+            }
+        });
+        match subscribed.recv() {
+            Ok(None) => Ok(Self { stop, handle }),
+            Ok(Some(error)) => anyhow::bail!("subscribing to the simulator's truth: {error}"),
+            Err(_) => anyhow::bail!("the simulator-truth recorder ended before subscribing"),
+        }
+    }
+
+    /// Stops recording; returns the states in the order published.
+    pub(crate) fn finish(self) -> anyhow::Result<Vec<SimTruth>> {
+        self.stop.store(true, Ordering::Relaxed);
+        self.handle
+            .join()
+            .map_err(|_| anyhow::anyhow!("the simulator-truth recorder panicked"))?
+            .context("recording the simulator's truth")
+    }
+}
+
+/// The state the daemon's tick saw when it wrote a status stamped `timestamp_ns`: the newest
+/// state read before then. `None` when there is none, or when the subscriber lost the states
+/// right after it (a gap in `seq`), so the newest one recorded may not be the newest published.
+pub(crate) fn state_at(states: &[SimTruth], timestamp_ns: u64) -> Option<&SimTruth> {
+    let after = states.partition_point(|s| s.timestamp_ns <= timestamp_ns);
+    let found = states.get(after.checked_sub(1)?)?;
+    match states.get(after) {
+        Some(next) if next.seq != found.seq + 1 => None,
+        _ => Some(found),
+    }
+}
+
+/// What the simulator says about a walk submitted at `submitted_ns` (monotonic).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Verdict {
+    /// The last state recorded (after the walk ended, the robot holding its last posture).
+    pub(crate) end: SimTruth,
+    /// Simulated time from submission at which the fall rule first fired (s).
+    pub(crate) fell_at_s: Option<f64>,
+    /// Largest `base_link` tilt from the vertical since submission (rad).
+    pub(crate) max_tilt_rad: f64,
+}
+
+impl Verdict {
+    /// The verdict of the recorded `states`; `None` when nothing was recorded.
+    pub(crate) fn of(states: &[SimTruth], submitted_ns: u64) -> Option<Self> {
+        let end = *states.last()?;
+        let since_submission = || states.iter().filter(|s| s.timestamp_ns >= submitted_ns);
+        let submitted_at = state_at(states, submitted_ns).map_or(0.0, |s| s.sim_time_s);
+        // The flag is sticky: the end state says whether a fall happened at all, even if the
+        // state where it first fired was lost.
+        let fell_at_s = end.fallen.then(|| {
+            let first = states.iter().find(|s| s.fallen).unwrap_or(&end);
+            first.sim_time_s - submitted_at
+        });
+        Some(Self {
+            end,
+            fell_at_s,
+            max_tilt_rad: since_submission().map(|s| s.tilt_rad).fold(0.0, f64::max),
+        })
+    }
+}
+
+/// The outcome of a walk the daemon ended with `daemon_outcome`, overruled by a fall the simulator
+/// saw `fell_at_s` after submission.
+pub(crate) fn judged_outcome(fell_at_s: Option<f64>, daemon_outcome: &str) -> String {
+    match fell_at_s {
+        Some(t) => format!("fell at {t:.1} s (daemon: {daemon_outcome})"),
+        None => daemon_outcome.to_owned(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(seq: u64, timestamp_ns: u64) -> SimTruth {
+        SimTruth {
+            seq,
+            timestamp_ns,
+            ..SimTruth::ZERO
+        }
+    }
+
+    #[test]
+    fn a_status_pairs_with_the_newest_state_read_before_it() {
+        let states = [state(1, 100), state(2, 200), state(3, 300)];
+        assert_eq!(state_at(&states, 99), None);
+        assert_eq!(state_at(&states, 100).map(|s| s.seq), Some(1));
+        assert_eq!(state_at(&states, 250).map(|s| s.seq), Some(2));
+        assert_eq!(state_at(&states, 1000).map(|s| s.seq), Some(3));
+    }
+
+    #[test]
+    fn a_state_followed_by_a_gap_is_not_trusted() {
+        let states = [state(1, 100), state(2, 200), state(7, 700)];
+        assert_eq!(state_at(&states, 150).map(|s| s.seq), Some(1));
+        assert_eq!(state_at(&states, 300), None);
+        assert_eq!(state_at(&states, 800).map(|s| s.seq), Some(7));
+    }
+}
+
+#[cfg(test)]
+mod verdict_tests {
+    use super::*;
+
+    fn state(seq: u64, tilt_rad: f64, fallen: bool) -> SimTruth {
+        SimTruth {
+            seq,
+            timestamp_ns: seq * 1000,
+            sim_time_s: seq as f64 * 0.5,
+            tilt_rad,
+            fallen,
+            ..SimTruth::ZERO
+        }
+    }
+
+    #[test]
+    fn the_first_fallen_state_dates_the_fall_from_submission() {
+        let states = [
+            state(1, 0.3, false),
+            state(2, 0.01, false),
+            state(3, 0.2, false),
+            state(4, 0.7, true),
+            state(5, 3.1, true),
+        ];
+        let verdict = Verdict::of(&states, 2000).unwrap();
+        assert_eq!(verdict.fell_at_s, Some(1.0));
+        assert_eq!(verdict.max_tilt_rad, 3.1);
+        assert_eq!(verdict.end.seq, 5);
+        assert_eq!(
+            judged_outcome(verdict.fell_at_s, "done"),
+            "fell at 1.0 s (daemon: done)"
+        );
+    }
+
+    #[test]
+    fn an_upright_walk_keeps_the_daemon_outcome() {
+        let states = [
+            state(1, 0.3, false),
+            state(2, 0.01, false),
+            state(3, 0.02, false),
+        ];
+        let verdict = Verdict::of(&states, 2000).unwrap();
+        assert_eq!(verdict.fell_at_s, None);
+        assert_eq!(verdict.max_tilt_rad, 0.02);
+        assert_eq!(
+            judged_outcome(verdict.fell_at_s, "fault: timeout"),
+            "fault: timeout"
+        );
+        assert_eq!(Verdict::of(&[], 0), None);
+    }
+}
