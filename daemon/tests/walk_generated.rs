@@ -5,46 +5,26 @@
 
 mod walk_support;
 
-use daemon::bench::{Outcome, WalkOptions, walk};
-use daemon::controller::{Phase, SolverKind};
-use stance::{AffordanceSet, GenerateOptions, PostProcessParams, PostProcessor};
+use daemon::bench::sequence::generated;
+use daemon::controller::SolverKind;
+use stance::learned::StanceSource;
+use stance::{AffordanceSet, PostProcessParams};
 
 fn generated_walk(robot_name: &str, affordances: AffordanceSet, distance: f64, solver: SolverKind) {
     let robot = walk_support::robot(robot_name);
-    let config = walk_support::controller_config(robot_name);
     let params =
         PostProcessParams::from_config_path(&walk_support::config_path(robot_name)).unwrap();
-    let raw = stance::generate(
+    let sequence = generated(
         &robot,
-        &GenerateOptions {
-            distance: distance / params.scf,
-            affordances,
-            seed: 0,
-        },
+        params,
+        &StanceSource::Synthetic,
+        distance,
+        affordances,
+        0,
     )
-    .expect("generator runs");
-    let sequence = PostProcessor::new(&robot, params)
-        .process(&raw)
-        .expect("post-processing runs");
-    let options = WalkOptions {
-        solver,
-        rate_hz: 200.0,
-        time_limit_s: 60.0 + 20.0 * sequence.len() as f64,
-    };
-    let mut last = (0, Phase::None);
-    let report = walk(robot, config, &sequence, &options, |o| {
-        last = (o.status.stance_index, o.status.phase);
-        walk_support::check_tick(o)
-    })
-    .expect("walk runs");
-    assert_eq!(
-        report.outcome,
-        Outcome::Done,
-        "{robot_name} {affordances} {distance} m {solver:?}: stopped at stance {} phase {:?}: {report:?}",
-        last.0,
-        last.1
-    );
-    assert!(report.distance_m > 0.5 * distance, "{report:?}");
+    .expect("generation and post-processing run");
+    let label = format!("{robot_name} {affordances} {distance} m {solver:?}");
+    walk_support::assert_walks_to_done(robot_name, &sequence, solver, 200.0, distance, &label);
 }
 
 /// One test per robot × affordance set × distance × solver.

@@ -19,15 +19,15 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use client::evaluate::{Points, TraceSample, align_targets, stance_points};
+use daemon::bench::sequence::generated;
 use daemon::controller::{
     Command, Controller, ControllerConfig, ControllerState, ControllerStatus, FaultCode,
     Measurement, SolverKind,
 };
 use kinematics::robot::{EndEffector, Robot};
 use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim};
-use stance::{
-    AffordanceSet, GenerateOptions, PostProcessParams, PostProcessedSequence, PostProcessor,
-};
+use stance::learned::StanceSource;
+use stance::{AffordanceSet, PostProcessParams, PostProcessedSequence};
 
 /// How to run a physics walk.
 #[derive(Clone, Copy, Debug)]
@@ -172,18 +172,15 @@ pub fn walk_distance(
     );
     let params = PostProcessParams::from_config_path(config)?;
     let controller_config = ControllerConfig::from_config_file(config)?;
-    let raw = stance::generate(
+    let sequence = generated(
         &robot,
-        &GenerateOptions {
-            distance: distance / params.scf,
-            affordances,
-            seed,
-        },
+        params,
+        &StanceSource::Synthetic,
+        distance,
+        affordances,
+        seed,
     )
-    .context("generating the stance sequence")?;
-    let sequence = PostProcessor::new(&robot, params)
-        .process(&raw)
-        .context("post-processing the stance sequence")?;
+    .context("generating and post-processing the stance sequence")?;
     walk_sequence(robot, controller_config, &sequence, options)
 }
 

@@ -54,7 +54,7 @@ impl From<SourceError> for SequenceError {
 }
 
 /// Generates a sequence that covers `distance` metres after post-processing: the source is asked
-/// for `distance / scf` (the paper's rule) with the railing, if any, along the whole walk.
+/// for `distance / scf` (the paper's rule), on flat ground without a railing.
 pub fn generated(
     robot: &Robot,
     params: PostProcessParams,
