@@ -25,7 +25,9 @@ mod walks {
     use client::evaluate::write_fig6;
     use stance::AffordanceSet;
     use walk_tests::config;
-    use walk_tests::physics::{PhysicsWalkOptions, PhysicsWalkReport, walk_distance};
+    use walk_tests::physics::{
+        PhysicsWalkOptions, PhysicsWalkReport, walk_distance, walk_sequence,
+    };
 
     /// The walk must end with each simulated sole this close to its final target (m). Each
     /// landing keeps the approach's residual error (within `position_tolerance_m`, 2 cm for
@@ -142,5 +144,81 @@ mod walks {
     #[test]
     fn armar4_walks_5m_feet_only() {
         check("armar4", AffordanceSet::Feet, 5.0);
+    }
+
+    /// Sequences from the learned n-gram model (`data/models/default-ngram.json`, retargeted and
+    /// post-processed) walk under physics too: each affordance set, 1 m, seed 0. The final
+    /// position error is not checked here: `align_targets` aligns on both feet of the first
+    /// stance, which for a learned sequence can be a single-support stance, so that number
+    /// measures the alignment rather than the walk.
+    fn check_learned(robot: &str) {
+        let config_path = config(robot);
+        let robot_model = std::sync::Arc::new(
+            kinematics::robot::Robot::load(&config_path, None).expect("robot loads"),
+        );
+        let params = stance::PostProcessParams::from_config_path(&config_path).unwrap();
+        let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../data/models/default-ngram.json");
+        let source = stance::learned::StanceSource::learned(&model, None).expect("model loads");
+        for affordances in [
+            AffordanceSet::Feet,
+            AffordanceSet::FeetLeftHand,
+            AffordanceSet::FeetRightHand,
+        ] {
+            let sequence = daemon::bench::sequence::generated(
+                &robot_model,
+                params.clone(),
+                &source,
+                1.0,
+                affordances,
+                0,
+            )
+            .expect("a learned sequence");
+            let controller = daemon::controller::ControllerConfig::from_config_file(&config_path)
+                .expect("controller config");
+            let report = walk_sequence(
+                robot_model.clone(),
+                controller,
+                &sequence,
+                &PhysicsWalkOptions::default(),
+            )
+            .expect("the walk runs");
+            let name = format!("{robot} learned {}", affordances.name());
+            eprintln!(
+                "{name} 1 m: {} after {} stances, sim {:.2} s, wall {:.2} s, drift {:.4} m, walked {:.3} m, max tilt {:.3} rad",
+                report.outcome.label(),
+                report.stances,
+                report.sim_s,
+                report.wall_s,
+                report.drift_m(),
+                report.distance_m,
+                report.max_tilt_rad
+            );
+            assert!(
+                report.success(),
+                "{name}: ended `{}`",
+                report.outcome.label()
+            );
+            assert!(
+                report.drift_m() < MAX_DRIFT_M,
+                "{name}: drift {:.4} m",
+                report.drift_m()
+            );
+            assert!(
+                report.distance_m > 0.8,
+                "{name}: walked {:.3} m",
+                report.distance_m
+            );
+        }
+    }
+
+    #[test]
+    fn jvrc1_walks_learned_sequences() {
+        check_learned("jvrc1");
+    }
+
+    #[test]
+    fn armar4_walks_learned_sequences() {
+        check_learned("armar4");
     }
 }
