@@ -37,9 +37,34 @@ pub fn sleep_until(deadline_ns: u64) {
     }
 }
 
+/// Sleeps until `spin_ns` before `deadline_ns`, then busy-waits to the deadline. A thread that is
+/// already running is not delayed by a late timer wake-up (on kernels without full preemption
+/// these can be late by more than a 1 ms period); the cost is `spin_ns` of CPU per call.
+pub fn sleep_then_spin_until(deadline_ns: u64, spin_ns: u64) {
+    sleep_until(deadline_ns.saturating_sub(spin_ns));
+    while monotonic_ns() < deadline_ns {
+        core::hint::spin_loop();
+    }
+}
+
+/// Whether the calling thread runs under `SCHED_FIFO`. Busy-waiting only pays off then: under
+/// the normal scheduler a spinning thread takes the CPU from the process it is waiting for.
+pub fn current_thread_is_fifo() -> bool {
+    // SAFETY: sched_getscheduler(0) only reads the calling thread's policy.
+    unsafe { libc::sched_getscheduler(0) == libc::SCHED_FIFO }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sleep_then_spin_until_returns_at_the_deadline() {
+        let deadline = monotonic_ns() + 2_000_000;
+        sleep_then_spin_until(deadline, 500_000);
+        assert!(monotonic_ns() >= deadline);
+        sleep_then_spin_until(0, 500_000); // a past deadline returns at once
+    }
 
     #[test]
     fn sleep_until_does_not_return_early() {

@@ -34,7 +34,7 @@ pub use ports::{
     AdapterPorts, ClientPorts, DaemonLoopPorts, DaemonServicePorts, TruthPublisher, TruthSubscriber,
 };
 
-pub use clock::{monotonic_ns, sleep_until};
+pub use clock::{current_thread_is_fifo, monotonic_ns, sleep_then_spin_until, sleep_until};
 pub use config::{ConfigError, RuntimeConfig};
 pub use error::ShmError;
 pub use messages::{

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use shm_types::{
     AdapterPorts, ClockMode, CommandMode, JointCommand, MAX_JOINTS, SensorSample, ShmError,
-    monotonic_ns, sleep_until,
+    monotonic_ns, sleep_then_spin_until,
 };
 
 use crate::RobotIo;
@@ -25,6 +25,9 @@ pub struct AdapterOptions {
     /// Lockstep: wall time without the awaited command before holding position (and
     /// re-publishing the current sample so a restarted daemon can pick up).
     pub lockstep_timeout: Duration,
+    /// Realtime: the last part of each period spent busy-waiting instead of sleeping, so a late
+    /// timer wake-up cannot delay a sample (zero: sleep through; see `sleep_then_spin_until`).
+    pub spin: Duration,
 }
 
 /// What happened during a run.
@@ -152,11 +155,12 @@ impl<R: RobotIo> Adapter<'_, R> {
 
     fn run_realtime(&mut self, should_stop: &dyn Fn() -> bool) -> Result<(), ShmError> {
         let period = (1e9 / self.options.rate_hz) as u64;
+        let spin = (self.options.spin.as_nanos() as u64).min(period);
         let mut stale_periods = 0;
         self.publish()?;
         let mut deadline = monotonic_ns() + period;
         while !should_stop() {
-            sleep_until(deadline);
+            sleep_then_spin_until(deadline, spin);
             if self.take_command(false)? {
                 stale_periods = 0;
             } else {

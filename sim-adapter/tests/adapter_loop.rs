@@ -51,6 +51,7 @@ fn start_adapter(
             rate_hz: 500.0,
             watchdog_periods: 5,
             lockstep_timeout: Duration::from_millis(50),
+            spin: Duration::ZERO,
         };
         run_adapter(&ports, &mut robot, &options, &|| {
             flag.load(Ordering::Relaxed)

@@ -18,7 +18,9 @@ use clap::{Parser, ValueEnum};
 use kinematic_sim::SafetySummary;
 use kinematics::robot::Robot;
 use shm_types::process::{exit_code, install_termination_handler, termination_requested};
-use shm_types::{AdapterPorts, ClockMode, RuntimeConfig, ServiceNames, TruthPublisher};
+use shm_types::{
+    AdapterPorts, ClockMode, RuntimeConfig, ServiceNames, TruthPublisher, current_thread_is_fifo,
+};
 use sim_adapter::{
     AdapterOptions, GroundTruth, KinematicRobot, PublishTruth, RobotIo, run_adapter,
 };
@@ -154,16 +156,25 @@ fn serve<R: RobotIo + GroundTruth>(
         TruthPublisher::open(&names, "walk-sim-truth").map_err(|e| (exit_code::IPC, e.into()))?;
     let mut sim = PublishTruth::new(sim, truth);
     install_termination_handler();
+    // Busy-wait the end of each period like walkd does, and only where it pays off: on
+    // SCHED_FIFO (e.g. `chrt -f`), in real time.
+    let spin = if runtime.spin_us > 0 && clock == ClockMode::Realtime && current_thread_is_fifo() {
+        Duration::from_micros(u64::from(runtime.spin_us))
+    } else {
+        Duration::ZERO
+    };
     let options = AdapterOptions {
         clock,
         rate_hz: runtime.rate_hz,
         watchdog_periods: runtime.watchdog_periods,
         lockstep_timeout: Duration::from_millis(runtime.lockstep_timeout_ms),
+        spin,
     };
     tracing::info!(
         prefix = names.prefix(),
         clock = clock.name(),
         rate_hz = runtime.rate_hz,
+        spin_us = spin.as_micros() as u64,
         "walk-sim running"
     );
     let report = run_adapter(&ports, &mut sim, &options, &termination_requested)
