@@ -498,19 +498,16 @@ impl StateMachine {
         let (com, com_velocity) = self.com_motion.sample(self.com_time);
         self.targets.com = com;
         self.targets.com_velocity = com_velocity;
-        let moving = if self.started {
-            let step = self.current_step();
-            match step.phase {
-                Phase::Unload | Phase::Lift | Phase::Swing | Phase::Lower | Phase::Reach => {
-                    step.end_effector
-                }
-                _ => None,
+        let step = self.started.then(|| self.current_step());
+        let moving = step.and_then(|step| match step.phase {
+            Phase::Unload | Phase::Lift | Phase::Swing | Phase::Lower | Phase::Reach => {
+                step.end_effector
             }
-        } else {
-            None
-        };
-        self.targets.unloading =
-            moving.filter(|_| self.started && self.current_step().phase == Phase::Unload);
+            _ => None,
+        });
+        self.targets.unloading = step
+            .filter(|step| step.phase == Phase::Unload)
+            .and_then(|step| step.end_effector);
         for e in EndEffector::ALL {
             let i = e as usize;
             self.targets.end_effectors[i] = if Some(e) == moving {
