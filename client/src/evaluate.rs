@@ -26,9 +26,10 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, bail};
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
-use nalgebra::Vector3;
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use plotters::prelude::*;
 use shm_types::{DaemonState, DaemonStatus, SimTruth};
+use stance::geometry::sequence_alignment;
 use stance::{AffordanceSet, PostProcessedSequence};
 
 use process::{Process, connect_when_fresh};
@@ -147,35 +148,44 @@ pub fn stance_points(robot: &Robot, sequence: &PostProcessedSequence) -> Vec<Poi
         .collect()
 }
 
-/// Moves `targets` (in the sequence's frame) onto the robot's standing feet `start` by the planar
-/// transform (x, y, yaw) that takes the first stance's feet midpoint and left-to-right direction
-/// onto the standing ones — the alignment the controller makes when a walk begins.
-pub fn align_targets(targets: &mut [Points], start: &Points) {
-    let Some(first) = targets.first().copied() else {
+/// Moves `targets` (in the sequence's frame) into the world the way the controller moves the
+/// sequence when the walk begins ([`sequence_alignment`]): the first stance's contact feet onto
+/// the robot's feet `standing` (`[left, right]` sole poses; every run starts on both feet).
+pub fn align_targets(
+    targets: &mut [Points],
+    sequence: &PostProcessedSequence,
+    standing: &[Isometry3<f64>; 2],
+) {
+    if sequence.is_empty() {
         return;
-    };
-    let heading = |p: &Points| {
-        let d = p.left_foot - p.right_foot;
-        d.y.atan2(d.x)
-    };
-    let midpoint = |p: &Points| (p.left_foot + p.right_foot) / 2.0;
-    let rotation =
-        nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), heading(start) - heading(&first));
-    let (from, to) = (midpoint(&first), midpoint(start));
-    let map = |v: Vector3<f64>| {
-        let mut p = rotation * (v - from);
-        p.x += to.x;
-        p.y += to.y;
-        p.z += from.z;
-        p
-    };
+    }
+    let contacts = sequence.contacts(0);
+    let first = [EndEffector::LeftFoot, EndEffector::RightFoot].map(|f| sequence.target(0, f));
+    let to_world = sequence_alignment(
+        &first,
+        [
+            contacts[EndEffector::LeftFoot as usize],
+            contacts[EndEffector::RightFoot as usize],
+        ],
+        standing,
+        [true, true],
+    );
+    let map = |v: Vector3<f64>| to_world * Point3::from(v);
     for target in targets {
         *target = Points {
-            com: map(target.com),
-            left_foot: map(target.left_foot),
-            right_foot: map(target.right_foot),
+            com: map(target.com).coords,
+            left_foot: map(target.left_foot).coords,
+            right_foot: map(target.right_foot).coords,
         };
     }
+}
+
+/// The pose a status carries as `[x, y, z, qx, qy, qz, qw]`.
+fn pose_of(pose: &[f64; 7]) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(pose[0], pose[1], pose[2]),
+        UnitQuaternion::from_quaternion(Quaternion::new(pose[6], pose[3], pose[4], pose[5])),
+    )
 }
 
 /// One sample of a Fig. 6 trace.
@@ -360,7 +370,8 @@ fn run_once(
     let start = client.status()?;
     align_targets(
         &mut targets,
-        &Points::from_status(&start.com, &start.left_foot, &start.right_foot),
+        &sequence,
+        &[pose_of(&start.left_foot), pose_of(&start.right_foot)],
     );
     let wall = Instant::now();
     let submitted_ns = shm_types::monotonic_ns();

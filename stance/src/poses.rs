@@ -8,6 +8,9 @@ use nalgebra::{Isometry3, Vector3};
 /// The two feet, in the order of the `[left, right]` arrays the passes use.
 pub const FEET: [EndEffector; 2] = [EndEffector::LeftFoot, EndEffector::RightFoot];
 
+/// The two hands, in the order of the `[left, right]` arrays the passes use.
+pub const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
+
 /// World-frame poses of a sequence: `roots[i]`, `end_effectors[i][e as usize]`, `contacts[i]`.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PoseSequence {

@@ -130,6 +130,36 @@ fn railing_hand_holds_only_with_its_affordance() {
 }
 
 #[test]
+fn railing_hand_lets_go_when_its_foot_wanders_out_of_reach() {
+    // JVRC-1, seed 1, 5 m (generated for 5 / scf): the left foot side-steps away from the
+    // railing on the right for four steps and the right foot follows towards the midline.
+    let (raw, poses) = raw_poses("jvrc1", AffordanceSet::FeetRightHand, 1, 5.0 / 0.16);
+    let railing = &raw.environment().hand_affordances[0];
+    let lateral_axis = nalgebra::Vector3::z().cross(&(railing.end - railing.start).normalize());
+    let from_railing = |i: usize| {
+        let foot = poses.pose(i, EndEffector::RightFoot).translation.vector;
+        (foot - railing.start).dot(&lateral_axis).abs()
+    };
+    // Standing, the right foot is this far from the railing; a grasp allows 0.1 human metres
+    // (JVRC-1 scale < 1) more, plus the IK's few centimetres.
+    let reach = from_railing(0) + 0.1 + 0.03;
+    let both_feet = |i: usize| FEET.iter().all(|&f| poses.in_contact(i, f));
+    let mut let_go = 0;
+    for i in 0..poses.len() {
+        if poses.in_contact(i, EndEffector::RightHand) {
+            assert!(
+                from_railing(i) <= reach,
+                "stance {i}: holds the railing {:.3} m from the right foot (reach {reach:.3} m)",
+                from_railing(i)
+            );
+        } else if both_feet(i) && i + 1 < poses.len() {
+            let_go += 1;
+        }
+    }
+    assert!(let_go > 0, "the hand never let go in double support");
+}
+
+#[test]
 fn every_impediment_is_present() {
     let (_, params) = common::armar4();
     let (mut below, mut jumping, mut long, mut crossing, mut high, mut tilted, mut rotated) =

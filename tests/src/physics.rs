@@ -213,7 +213,11 @@ pub fn walk_sequence(
     let settle_ticks = (options.settle_s * options.rate_hz).ceil() as u64;
     let mut command = Command::new(robot.model.dof());
     let start_midpoint = feet_midpoint(&sim);
-    align_targets(&mut targets, &sim_points(&sim));
+    align_targets(
+        &mut targets,
+        sequence,
+        &[EndEffector::LeftFoot, EndEffector::RightFoot].map(|f| sim.end_effector_pose(f)),
+    );
     let initial_height = sim.base_height();
     let mut loop_state = LoopState {
         trace: Vec::with_capacity((max_ticks / options.trace_every.max(1)).min(1 << 20) as usize),

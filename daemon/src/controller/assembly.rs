@@ -2,9 +2,10 @@
 //!
 //! ```text
 //! min  Σ_k w_k ‖J_k ν − v*_k‖² + λ‖ν‖²        v*_k = feed-forward + K_k · error_k
-//! s.t. J_c ν = 0                               feet in contact
+//! s.t. J_c ν = c                               feet in contact (c: bounded anchor correction)
 //!      n_eᵀ J_com,xy ν ≤ k_s (d_e − m − n_eᵀ c) CoM stays in the support polygon shrunk by m
 //!      q̇ within velocity limits and (q_min + margin − q_cmd)/dt ≤ q̇ ≤ (q_max − margin − q_cmd)/dt
+//!      |v_base|, |ω_base| ≤ max_base_speed, |ω_x|, |ω_y| ≤ max_base_tilt_speed (roll/pitch rate)
 //! ```
 //!
 //! The position limits act on `q_cmd`, the joint command the controller integrates (the servos
@@ -214,8 +215,15 @@ impl QpAssembler {
                 &hold,
                 config.pose_gain,
             );
+            // The correction is meant for the small drift of J_c ν = 0. A foot that touches down
+            // while the stance sole rolls on its edge is estimated millimetres off the ground it
+            // is anchored to; correcting that at the full gain kicks the leg into the ground and
+            // the robot off its other foot, so the correction speed is bounded.
+            let scale = speed_scale(&correction[..3], config.max_anchor_correction_speed).min(
+                speed_scale(&correction[3..], config.max_anchor_correction_angular_speed),
+            );
             for (k, value) in correction.iter().enumerate() {
-                b_eq[row + k] = *value;
+                b_eq[row + k] = value * scale;
             }
             row += 6;
         }
@@ -237,9 +245,18 @@ impl QpAssembler {
 
         // Velocity and position limits.
         let (mut x_min, mut x_max) = (qp.x_min, qp.x_max);
+        // The base's roll and pitch rates (ω_x, ω_y) have their own, usually tighter, bound: a
+        // pelvis that tilts fast (a robot with little ankle roll shifts its CoM partly by rolling
+        // the pelvis) exerts a reaction torque on the stance sole that rolls it over its edge.
+        let tilt_speed = config.max_base_speed.min(config.max_base_tilt_speed);
         for k in 0..6 {
-            x_min[k] = -config.max_base_speed;
-            x_max[k] = config.max_base_speed;
+            let bound = if k == 3 || k == 4 {
+                tilt_speed
+            } else {
+                config.max_base_speed
+            };
+            x_min[k] = -bound;
+            x_max[k] = bound;
         }
         for (j, limit) in model.joint_limits().iter().enumerate() {
             let speed = config.velocity_limit_scale * limit.velocity;
@@ -279,6 +296,12 @@ fn pose_velocity(pose: &Isometry3<f64>, target: &PoseTarget, gain: f64) -> [f64;
         desired[3 + k] += gain * rotation_error[k];
     }
     desired
+}
+
+/// The factor (≤ 1) that scales the velocity `v` down to at most `max` in norm.
+fn speed_scale(v: &[f64], max: f64) -> f64 {
+    let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if norm > max { max / norm } else { 1.0 }
 }
 
 /// Adds `w ‖J ν − v*‖²` (first `rows` rows of `jacobian`, non-zero `columns` only):

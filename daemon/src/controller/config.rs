@@ -36,6 +36,17 @@ pub struct ControllerConfig {
     pub velocity_limit_scale: f64,
     /// Bound on each base velocity component (m/s, rad/s).
     pub max_base_speed: f64,
+    /// Bound on the base's roll and pitch rates (world x and y components of ω, rad/s; the
+    /// smaller of this and `max_base_speed` applies). A pelvis that tilts fast pushes the stance
+    /// sole over its edge by reaction; robots that shift the CoM by tilting the pelvis (little
+    /// ankle roll) need this well below `max_base_speed`.
+    pub max_base_tilt_speed: f64,
+    /// Bound on the speed at which a foot in contact is pulled back to its anchor (m/s). The
+    /// correction `pose_gain · (anchor − pose)` removes drift; after a touchdown on a tilted robot
+    /// the error is millimetres and correcting it at the full gain kicks the robot.
+    pub max_anchor_correction_speed: f64,
+    /// The same for the foot's orientation (rad/s).
+    pub max_anchor_correction_angular_speed: f64,
     /// The CoM ground projection stays this far inside the support polygon (m).
     pub support_margin_m: f64,
     /// Rate at which the CoM may approach the shrunk support polygon's edge (1/s).
@@ -93,6 +104,12 @@ pub struct ControllerConfig {
     /// by more than this angle (rad): the stance feet are no longer flat on the ground. Only
     /// checked when the measurement has an IMU.
     pub tipping_detection_rad: f64,
+    /// Whether a hand that lets go is carried along with the pelvis, as it held, until its next
+    /// reach, instead of being left to the posture task. Returning to the posture at once
+    /// twists the torso back abruptly (JVRC-1 turns its waist ~0.3 rad to hold a railing), which
+    /// makes the stance foot slip about its vertical axis; a robot with heavy arms and little
+    /// ankle roll (ARMAR-4) cannot balance with the arm left out to the side.
+    pub carry_released_hands: bool,
 }
 
 impl Default for ControllerConfig {
@@ -111,6 +128,9 @@ impl Default for ControllerConfig {
             joint_limit_margin_rad: 0.02,
             velocity_limit_scale: 0.5,
             max_base_speed: 1.0,
+            max_base_tilt_speed: 1.0,
+            max_anchor_correction_speed: 1.0,
+            max_anchor_correction_angular_speed: 10.0,
             support_margin_m: 0.02,
             support_gain: 20.0,
             com_speed: 0.05,
@@ -137,6 +157,7 @@ impl Default for ControllerConfig {
             command_lead_max_rad: 0.05,
             unload_foot_weight: 100.0,
             tipping_detection_rad: 0.25,
+            carry_released_hands: false,
         }
     }
 }
@@ -234,6 +255,15 @@ impl ControllerConfig {
             ("torso_gain", self.torso_gain),
             ("posture_gain", self.posture_gain),
             ("max_base_speed", self.max_base_speed),
+            ("max_base_tilt_speed", self.max_base_tilt_speed),
+            (
+                "max_anchor_correction_speed",
+                self.max_anchor_correction_speed,
+            ),
+            (
+                "max_anchor_correction_angular_speed",
+                self.max_anchor_correction_angular_speed,
+            ),
             ("support_gain", self.support_gain),
             ("com_speed", self.com_speed),
             ("swing_speed", self.swing_speed),

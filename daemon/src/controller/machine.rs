@@ -8,7 +8,8 @@
 
 use kinematic_sim::support::{SupportPolygon, sole_corners};
 use kinematics::robot::{EndEffector, SoleRectangle};
-use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
+use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
+use stance::geometry::{planar_frame, sequence_alignment};
 
 use super::config::ControllerConfig;
 use super::plan::{Step, TransitionPlan};
@@ -22,6 +23,8 @@ const FEET: [EndEffector; 2] = [EndEffector::LeftFoot, EndEffector::RightFoot];
 pub(crate) struct Feedback<'a> {
     /// Centre of mass.
     pub com: Vector3<f64>,
+    /// Pelvis pose.
+    pub pelvis: Isometry3<f64>,
     /// End-effector poses by `EndEffector`.
     pub poses: &'a [Isometry3<f64>; 4],
     /// FT normal (world z) force by `EndEffector` (N).
@@ -87,6 +90,10 @@ pub(crate) struct StateMachine {
     com_motion: PointTrajectory,
     com_time: f64,
     free_targets: [Option<Isometry3<f64>>; 4],
+    /// Released hands, carried along with the pelvis: their pose relative to its planar frame
+    /// (x, y, yaw) at release. Planar, so the pelvis roll of ARMAR-4's hip strategy does not
+    /// swing them sideways.
+    carried: [Option<Isometry3<f64>>; 4],
     targets: Targets,
 }
 
@@ -113,6 +120,7 @@ impl StateMachine {
             com_motion: PointTrajectory::new(Vector2::zeros(), Vector2::zeros(), 1.0),
             com_time: 0.0,
             free_targets: [None; 4],
+            carried: [None; 4],
             targets: Targets {
                 contacts: [false; 4],
                 anchors: [Isometry3::identity(); 4],
@@ -199,13 +207,13 @@ impl StateMachine {
                 StepStatus::Complete => {
                     self.finish_step(feedback);
                     if !self.advance(feedback) {
-                        self.refresh_targets();
+                        self.refresh_targets(&feedback.pelvis);
                         return Progress::Done;
                     }
                 }
             }
         }
-        self.refresh_targets();
+        self.refresh_targets(&feedback.pelvis);
         Progress::Running
     }
 
@@ -231,29 +239,17 @@ impl StateMachine {
     }
 
     /// The planar (x, y, yaw) transform taking the first stance's contact feet onto the feet
-    /// standing now.
+    /// standing now ([`sequence_alignment`]).
     fn alignment(&self) -> Isometry3<f64> {
         let first = &self.sequence().stances[0];
-        let mut shared = FEET.map(|f| {
-            let e = f as usize;
-            self.targets.contacts[e] && first.contacts[e]
-        });
-        if !shared.iter().any(|s| *s) {
-            shared = FEET.map(|f| self.targets.contacts[f as usize]);
-        }
-        let world = planar_frame(
-            FEET.iter()
-                .zip(shared)
-                .filter(|(_, s)| *s)
-                .map(|(f, _)| &self.targets.anchors[*f as usize]),
-        );
-        let sequence = planar_frame(
-            FEET.iter()
-                .zip(shared)
-                .filter(|(_, s)| *s)
-                .map(|(f, _)| &first.targets[*f as usize]),
-        );
-        world * sequence.inverse()
+        let feet = |flags: &[bool; 4]| FEET.map(|f| flags[f as usize]);
+        let poses = |all: &[Isometry3<f64>; 4]| FEET.map(|f| all[f as usize]);
+        sequence_alignment(
+            &poses(&first.targets),
+            feet(&first.contacts),
+            &poses(&self.targets.anchors),
+            feet(&self.targets.contacts),
+        )
     }
 
     fn world_target(&self, e: EndEffector) -> Isometry3<f64> {
@@ -264,8 +260,13 @@ impl StateMachine {
         let next = self.sequence().stances[self.stance].contacts;
         let is_last = self.stance + 1 == self.sequence().len();
         for hand in [EndEffector::LeftHand, EndEffector::RightHand] {
-            if !next[hand as usize] {
-                self.targets.contacts[hand as usize] = false;
+            let h = hand as usize;
+            if !next[h] && self.targets.contacts[h] {
+                self.targets.contacts[h] = false;
+                if self.config.carry_released_hands {
+                    self.carried[h] =
+                        Some(heading_frame(&feedback.pelvis).inverse() * self.targets.anchors[h]);
+                }
             }
         }
         self.plan = TransitionPlan::new(self.targets.contacts, next, is_last);
@@ -487,6 +488,7 @@ impl StateMachine {
             }
             Phase::Reach => {
                 self.targets.contacts[i] = true;
+                self.carried[i] = None;
                 self.targets.anchors[i] = *self.motion.goal();
             }
             Phase::Lift | Phase::Swing => self.free_targets[i] = Some(*self.motion.goal()),
@@ -494,7 +496,7 @@ impl StateMachine {
         }
     }
 
-    fn refresh_targets(&mut self) {
+    fn refresh_targets(&mut self, pelvis: &Isometry3<f64>) {
         let (com, com_velocity) = self.com_motion.sample(self.com_time);
         self.targets.com = com;
         self.targets.com_velocity = com_velocity;
@@ -519,7 +521,8 @@ impl StateMachine {
                     velocity: [0.0; 6],
                 })
             } else {
-                self.free_targets[i].map(|pose| PoseTarget {
+                let carried = self.carried[i].map(|relative| heading_frame(pelvis) * relative);
+                carried.or(self.free_targets[i]).map(|pose| PoseTarget {
                     pose,
                     velocity: [0.0; 6],
                 })
@@ -534,30 +537,15 @@ enum StepStatus {
     TimedOut,
 }
 
+/// The planar frame (x, y, yaw) of `pose`.
+fn heading_frame(pose: &Isometry3<f64>) -> Isometry3<f64> {
+    planar_frame(std::iter::once(pose))
+}
+
 /// `pose` moved up by `height` along world z.
 fn raised(pose: &Isometry3<f64>, height: f64) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::from(pose.translation.vector + Vector3::z() * height),
         pose.rotation,
-    )
-}
-
-/// The planar frame (mean x, y and mean yaw) of some poses.
-fn planar_frame<'a>(poses: impl Iterator<Item = &'a Isometry3<f64>>) -> Isometry3<f64> {
-    let (mut x, mut y, mut sin, mut cos, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for pose in poses {
-        let (_, _, yaw) = pose.rotation.euler_angles();
-        x += pose.translation.x;
-        y += pose.translation.y;
-        sin += yaw.sin();
-        cos += yaw.cos();
-        n += 1.0;
-    }
-    if n == 0.0 {
-        return Isometry3::identity();
-    }
-    Isometry3::from_parts(
-        Translation3::new(x / n, y / n, 0.0),
-        UnitQuaternion::from_euler_angles(0.0, 0.0, sin.atan2(cos)),
     )
 }

@@ -228,6 +228,7 @@ impl Controller {
         }
         let feedback = Feedback {
             com: self.kinematics.com(),
+            pelvis: *self.kinematics.link_pose(self.robot.base_link),
             poses: &self.poses,
             normal_forces: measurement.wrenches.map(|w| w[2]),
         };

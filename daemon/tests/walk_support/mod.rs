@@ -184,9 +184,13 @@ pub struct Harness {
 impl Harness {
     /// A standing robot `name` with the dense solver at `rate_hz`.
     pub fn new(name: &str, rate_hz: f64) -> Self {
+        Self::with_config(name, controller_config(name), rate_hz)
+    }
+
+    /// [`Harness::new`] with `config` instead of the robot's `[controller]` section.
+    pub fn with_config(name: &str, config: ControllerConfig, rate_hz: f64) -> Self {
         let robot = robot(name);
-        let controller =
-            Controller::new(robot.clone(), controller_config(name), SolverKind::Dense).unwrap();
+        let controller = Controller::new(robot.clone(), config, SolverKind::Dense).unwrap();
         let sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
         let command = Command::new(robot.model.dof());
         Self {

@@ -64,6 +64,10 @@ const P_FEET_CROSSING: f64 = 0.2;
 /// outside the standing hand (human metres).
 const HAND_REACH: f64 = 0.1;
 const RAILING_CLEARANCE: f64 = 0.1;
+/// How much farther sideways than when standing the railing may be from the foot on the hand's
+/// side while the hand holds it (human metres): a walker whose steps wander away from the
+/// railing lets go of it rather than overstretch the arm.
+const RAILING_REACH_SLACK: f64 = 0.1;
 
 /// A Gaussian sample (Box–Muller).
 pub(crate) fn gaussian(rng: &mut ChaCha8Rng, mean: f64, sd: f64) -> f64 {
@@ -243,11 +247,14 @@ fn footprints(
 }
 
 /// When and where the railing hand grasps: it holds while its stance is inside the railing's
-/// available part of the path and lets go (to move ahead) while the foot on its side swings.
+/// available part of the path and the railing is within the arm's reach of the foot on its side,
+/// and lets go (to move ahead) while that foot swings.
 struct HandSchedule {
     hand: Option<(usize, usize)>, // (end-effector index, foot index on the same side)
     railing: Option<(Vector3<f64>, Vector3<f64>)>,
     available: [f64; 2],
+    /// Largest lateral distance between the railing and the foot on the hand's side for a grasp.
+    reach: f64,
     grasp: Option<Isometry3<f64>>,
 }
 
@@ -258,10 +265,20 @@ impl HandSchedule {
             Railing::Left => Some((EndEffector::LeftHand as usize, 0)),
             Railing::Right => Some((EndEffector::RightHand as usize, 1)),
         };
+        let railing = body.railing(railing, distance);
+        let reach = match (hand, railing) {
+            (Some((_, foot)), Some((start, _))) => {
+                let standing_foot = if foot == 0 { 1.0 } else { -1.0 } * body.half_width;
+                (body.lateral_axis().dot(&start) - standing_foot).abs()
+                    + RAILING_REACH_SLACK * body.scale
+            }
+            _ => 0.0,
+        };
         Self {
             hand,
-            railing: body.railing(railing, distance),
+            railing,
             available,
+            reach,
             grasp: None,
         }
     }
@@ -272,7 +289,11 @@ impl HandSchedule {
         };
         let along = stance.support.dot(&body.forward);
         let available = (self.available[0]..=self.available[1]).contains(&along);
-        if !available || swinging_foot == Some(foot) {
+        let within_reach = stance.targets[foot].is_some_and(|sole| {
+            let lateral = body.lateral_axis().dot(&(start - sole.translation.vector));
+            lateral.abs() <= self.reach
+        });
+        if !available || swinging_foot == Some(foot) || !within_reach {
             self.grasp = None;
             return;
         }

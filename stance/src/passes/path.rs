@@ -4,7 +4,7 @@ use kinematics::robot::EndEffector;
 use nalgebra::Vector3;
 
 use crate::geometry::PathFrame;
-use crate::poses::{FEET, PoseSequence};
+use crate::poses::{FEET, HANDS, PoseSequence};
 
 /// Pass 6, `scaleTranslation(scf)`: multiplies every along-path coordinate (roots and all
 /// end-effectors) by `scf`, keeping lateral offsets and heights. The map depends on the pose
@@ -126,6 +126,11 @@ impl StepLimit<'_> {
 /// the other stands is moved sideways (its whole contact run) to satisfy the limits against the
 /// standing foot; feet that land together are moved symmetrically; a swing foot is moved
 /// against the foot in support. Feet already inside the limits are not touched.
+///
+/// Hands in contact move with the feet: a hand's contact run shifts sideways (as a whole, so no
+/// contact jumps) by the mean shift of the feet in contact at its first stance. Otherwise the
+/// corrections, which accumulate over a long walk, would carry the feet away from a railing the
+/// hand holds until it is out of the arm's reach.
 pub fn limit_orthogonal_feet_distance(
     poses: &mut PoseSequence,
     path: &PathFrame,
@@ -134,6 +139,7 @@ pub fn limit_orthogonal_feet_distance(
 ) {
     let [left, right] = FEET;
     let mut run_offset = [0.0; 2];
+    let mut hand_offset = [0.0; 2];
     let lateral = |poses: &PoseSequence, i: usize, e: EndEffector| {
         path.lateral(&poses.pose(i, e).translation.vector)
     };
@@ -163,6 +169,14 @@ pub fn limit_orthogonal_feet_distance(
                 poses.translate(i, foot, &(path.lateral_axis() * run_offset[f]));
             }
         }
+        for (h, &hand) in HANDS.iter().enumerate() {
+            if poses.contact_starts(i, hand) {
+                hand_offset[h] = mean_support_offset(poses, i, &run_offset);
+            }
+            if poses.in_contact(i, hand) && hand_offset[h] != 0.0 {
+                poses.translate(i, hand, &(path.lateral_axis() * hand_offset[h]));
+            }
+        }
         let swing = match (poses.in_contact(i, left), poses.in_contact(i, right)) {
             (true, false) => Some((right, -1.0)),
             (false, true) => Some((left, 1.0)),
@@ -178,12 +192,22 @@ pub fn limit_orthogonal_feet_distance(
     }
 }
 
+/// Mean lateral shift of the feet in contact in stance `i` (zero when none is).
+fn mean_support_offset(poses: &PoseSequence, i: usize, run_offset: &[f64; 2]) -> f64 {
+    let (sum, count) = FEET
+        .iter()
+        .zip(run_offset)
+        .filter(|(foot, _)| poses.in_contact(i, **foot))
+        .fold((0.0, 0.0), |(sum, n), (_, offset)| (sum + offset, n + 1.0));
+    if count == 0.0 { 0.0 } else { sum / count }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::derived::{orthogonal_distances, steps};
     use crate::passes::fixtures::{BOTH, LEFT, RIGHT, stance, walk};
-    use kinematics::robot::EndEffector::{LeftFoot, RightFoot};
+    use kinematics::robot::EndEffector::{LeftFoot, LeftHand, RightFoot, RightHand};
 
     fn x_path() -> PathFrame {
         PathFrame::new(&Vector3::zeros(), &Vector3::x()).unwrap()
@@ -261,6 +285,28 @@ mod tests {
         for o in orthogonal_distances(&p, &x_path()) {
             assert!((0.18 - 1e-12..=0.3 + 1e-12).contains(&o), "{o}");
         }
+    }
+
+    #[test]
+    fn a_held_railing_moves_with_the_feet() {
+        const BOTH_RIGHT_HAND: [bool; 4] = [true, true, false, true];
+        let mut p = walk(&[
+            stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH),
+            stance([0.0, 0.1, 0.0], [0.2, 0.05, 0.1], LEFT),
+            stance([0.0, 0.1, 0.0], [0.4, 0.12, 0.0], BOTH_RIGHT_HAND),
+            stance([0.0, 0.1, 0.0], [0.4, 0.12, 0.0], BOTH_RIGHT_HAND),
+        ]);
+        let before = p.pose(2, RightHand).translation.y;
+        let free_hand = *p.pose(2, LeftHand);
+        limit_orthogonal_feet_distance(&mut p, &x_path(), 0.18, 0.3);
+        // The right foot moved 0.2 m to the right, the left one stayed: the mean is 0.1 m.
+        assert!((p.pose(2, RightHand).translation.y - (before - 0.1)).abs() < 1e-12);
+        assert_eq!(
+            p.pose(3, RightHand),
+            p.pose(2, RightHand),
+            "contact run static"
+        );
+        assert_eq!(*p.pose(2, LeftHand), free_hand, "free hands untouched");
     }
 
     #[test]
