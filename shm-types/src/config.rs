@@ -33,7 +33,8 @@ pub struct RuntimeConfig {
     #[serde(default)]
     pub lock_memory: bool,
     /// The daemon busy-polls for each sample from this long (µs) before to this long after its
-    /// expected time instead of sleeping through it (0: sleep and wait for the sample event).
+    /// expected time instead of sleeping through it (0: sleep and wait for the sample event;
+    /// half a period or more: never sleep, which takes a core of its own).
     #[serde(default)]
     pub spin_us: u32,
 }

@@ -7,7 +7,8 @@
 //! command. With a spin time (`[runtime] spin_us`) it sleeps instead until `spin` before the
 //! expected sample and busy-polls shared memory for it until `spin` after, so neither a
 //! cross-process wake-up nor a late timer wake-up of up to `spin` lies between the sample and
-//! the command; only then (adapter late) it blocks on the sample event. Deadline accounting:
+//! the command; only then (adapter late) it blocks on the sample event. From half a period on
+//! it polls from one command to the next sample and never sleeps. Deadline accounting:
 //! - a command sent after the end of its sample's period is a deadline miss, and so is every
 //!   period the overrun swallowed; the grid then continues with the first period that has not
 //!   ended (no catching up);
@@ -157,7 +158,9 @@ impl ControlLoop {
 
     fn run_realtime(&mut self) -> Result<(), ShmError> {
         let period = self.timing.period_ns;
-        let spin = self.timing.spin_ns.min(period / 2);
+        // A spin of half a period or more starts polling as soon as the previous command is
+        // out: the thread never sleeps, so no timer wake-up can be late (a core of its own).
+        let spin = self.timing.spin_ns.min(period);
         let loop_start = monotonic_ns();
         // `start` is the beginning of the current period; samples are expected at its middle.
         let mut start: Option<u64> = None;
