@@ -30,6 +30,7 @@ use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vect
 use plotters::prelude::*;
 use shm_types::{DaemonState, DaemonStatus, SimTruth};
 use stance::geometry::sequence_alignment;
+use stance::poses::FEET;
 use stance::{AffordanceSet, PostProcessedSequence};
 
 use process::{Process, connect_when_fresh};
@@ -160,13 +161,9 @@ pub fn align_targets(
         return;
     }
     let contacts = sequence.contacts(0);
-    let first = [EndEffector::LeftFoot, EndEffector::RightFoot].map(|f| sequence.target(0, f));
     let to_world = sequence_alignment(
-        &first,
-        [
-            contacts[EndEffector::LeftFoot as usize],
-            contacts[EndEffector::RightFoot as usize],
-        ],
+        &FEET.map(|f| sequence.target(0, f)),
+        FEET.map(|f| contacts[f as usize]),
         standing,
         [true, true],
     );

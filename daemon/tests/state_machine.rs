@@ -32,6 +32,22 @@ fn run_until(h: &mut Harness, phase: Phase) {
     panic!("phase {phase:?} never reached");
 }
 
+/// Ticks the walk to `done`, safe and executing on every tick, calling `observe` after each
+/// executing tick.
+fn walk_to_done(h: &mut Harness, mut observe: impl FnMut(&Harness)) {
+    for _ in 0..MAX_TICKS {
+        h.tick();
+        h.assert_safe();
+        let status = h.controller.status();
+        if status.state == ControllerState::Done {
+            return;
+        }
+        assert_eq!(status.state, ControllerState::Executing, "{status:?}");
+        observe(h);
+    }
+    panic!("the walk did not end in {MAX_TICKS} ticks");
+}
+
 #[test]
 fn touchdown_never_confirmed_is_a_lower_timeout_fault() {
     let mut h = started("jvrc1", false);
@@ -241,14 +257,7 @@ fn the_base_roll_and_pitch_rates_keep_their_own_bound_through_a_walk() {
     let mut h = started("armar4", false);
     let mut previous = h.sim.measurement().base_orientation;
     let mut fastest_tilt: f64 = 0.0;
-    for _ in 0..MAX_TICKS {
-        h.tick();
-        h.assert_safe();
-        let status = h.controller.status();
-        if status.state == ControllerState::Done {
-            break;
-        }
-        assert_eq!(status.state, ControllerState::Executing, "{status:?}");
+    walk_to_done(&mut h, |h| {
         let qp = h.controller.last_problem();
         for k in 0..6 {
             let bound = if k == 3 || k == 4 {
@@ -267,8 +276,7 @@ fn the_base_roll_and_pitch_rates_keep_their_own_bound_through_a_walk() {
         let omega = (orientation * previous.inverse()).scaled_axis() / h.dt;
         fastest_tilt = fastest_tilt.max(omega.x.abs()).max(omega.y.abs());
         previous = orientation;
-    }
-    assert_eq!(h.controller.status().state, ControllerState::Done);
+    });
     assert!(
         fastest_tilt <= config.max_base_tilt_speed * 1.05,
         "base tilted at {fastest_tilt} rad/s, bound {}",
@@ -316,22 +324,14 @@ fn a_released_hand_is_carried_with_the_pelvis_only_when_configured() {
         h.start(&sequence);
         let mut at_release = None;
         let mut moved: f64 = 0.0;
-        for _ in 0..MAX_TICKS {
-            h.tick();
-            h.assert_safe();
-            let status = h.controller.status();
-            if status.state == ControllerState::Done {
-                break;
-            }
-            assert_eq!(status.state, ControllerState::Executing, "{status:?}");
-            if status.stance_index >= 2 {
-                let relative = hand_in_pelvis_frame(&h);
+        walk_to_done(&mut h, |h| {
+            if h.controller.status().stance_index >= 2 {
+                let relative = hand_in_pelvis_frame(h);
                 let first = *at_release.get_or_insert(relative);
                 let offset = relative.translation.vector - first.translation.vector;
                 moved = moved.max(offset.norm());
             }
-        }
-        assert_eq!(h.controller.status().state, ControllerState::Done);
+        });
         // Held, the hand is 3 cm ahead of where the standing posture puts it: carried it stays
         // there relative to the pelvis (up to the pose task's lag while the pelvis moves, 5.4
         // mm measured); left to the posture task it swings back (3.7 cm measured).

@@ -4,9 +4,18 @@
 //! (`sim-truth`): under MuJoCo physics (walk-sim must be built with `--features
 //! sim-adapter/mujoco`; otherwise the test fails with walk-sim's explanation) and kinematically.
 
-use std::process::Command;
+use std::process::{Command, Output};
 
 use walk_tests::{bin_dir, config, unique_prefix, workspace_dir};
+
+/// The JSON report a `walkctl … --json` run printed, and its stderr (for messages).
+fn json_report(output: &Output) -> (serde_json::Value, String) {
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    let report = serde_json::from_str(stdout.trim())
+        .unwrap_or_else(|e| panic!("no JSON report ({e}); stdout: {stdout}\nstderr: {stderr}"));
+    (report, stderr)
+}
 
 /// Runs `walkctl demo --json` and checks the reported outcome.
 fn demo_walk(test: &str, robot: &str, clock: &str) {
@@ -27,10 +36,7 @@ fn demo_walk(test: &str, robot: &str, clock: &str) {
         .args(["--service-prefix", &unique_prefix(test)])
         .output()
         .expect("walkctl runs (build the binaries first: cargo build --release --bins)");
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    let report: serde_json::Value = serde_json::from_str(stdout.trim())
-        .unwrap_or_else(|e| panic!("no JSON report ({e}); stdout: {stdout}\nstderr: {stderr}"));
+    let (report, stderr) = json_report(&output);
     assert_eq!(report["outcome"], "done", "{report}\n{stderr}");
     assert!(output.status.success(), "{stderr}");
     let covered = report["distance_m"].as_f64().unwrap();
@@ -83,10 +89,7 @@ fn evaluate_walk(robot: &str, physics: &str, distance: f64) -> serde_json::Value
         ])
         .output()
         .expect("walkctl runs (build the binaries first: cargo build --release --bins)");
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    let report: serde_json::Value = serde_json::from_str(stdout.trim())
-        .unwrap_or_else(|e| panic!("no JSON report ({e}); stdout: {stdout}\nstderr: {stderr}"));
+    let (report, stderr) = json_report(&output);
     let run = report["runs"][0].clone();
     assert_eq!(run["outcome"], "done", "{run}\n{stderr}");
     assert_eq!(

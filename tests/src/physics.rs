@@ -27,6 +27,7 @@ use daemon::controller::{
 use kinematics::robot::{EndEffector, Robot};
 use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim};
 use stance::learned::StanceSource;
+use stance::poses::FEET;
 use stance::{AffordanceSet, PostProcessParams, PostProcessedSequence};
 
 /// How to run a physics walk.
@@ -216,7 +217,7 @@ pub fn walk_sequence(
     align_targets(
         &mut targets,
         sequence,
-        &[EndEffector::LeftFoot, EndEffector::RightFoot].map(|f| sim.end_effector_pose(f)),
+        &FEET.map(|f| sim.end_effector_pose(f)),
     );
     let initial_height = sim.base_height();
     let mut loop_state = LoopState {

@@ -268,7 +268,8 @@ impl HandSchedule {
         let railing = body.railing(railing, distance);
         let reach = match (hand, railing) {
             (Some((_, foot)), Some((start, _))) => {
-                let standing_foot = if foot == 0 { 1.0 } else { -1.0 } * body.half_width;
+                let side = if foot == 0 { 1.0 } else { -1.0 };
+                let standing_foot = side * body.half_width;
                 (body.lateral_axis().dot(&start) - standing_foot).abs()
                     + RAILING_REACH_SLACK * body.scale
             }
