@@ -5,6 +5,8 @@
 //! The binaries come from `WALK_BIN_DIR`, else from the workspace's `target/release` (build them
 //! first: `cargo build --release --bins`).
 
+/// Peers that write raw message bytes to walkd's services.
+pub mod hostile;
 /// The controller walking under MuJoCo physics, in one process (feature `mujoco`).
 #[cfg(feature = "mujoco")]
 pub mod physics;
@@ -213,6 +215,28 @@ pub fn connect_when_fresh(prefix: &str, timeout: Duration) -> anyhow::Result<Dae
         let fresh = client.is_running() && client.status().ok()?.link == LinkState::Fresh;
         fresh.then_some(client)
     })
+}
+
+/// Connects to the daemon on `prefix`, whatever its adapter link.
+pub fn connect(prefix: &str) -> anyhow::Result<DaemonClient> {
+    DaemonClient::connect(prefix)
+}
+
+/// Runs `walkctl` with `args` to its end; its stdout, or an error with its stderr.
+pub fn run_walkctl(args: &[&str]) -> anyhow::Result<String> {
+    let output = Command::new(bin_dir().join("walkctl"))
+        .args(args)
+        .output()
+        .context("cannot run walkctl")?;
+    if !output.status.success() {
+        bail!(
+            "walkctl {} failed ({}): {}",
+            args.join(" "),
+            output.status,
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+    Ok(String::from_utf8_lossy(&output.stdout).into_owned())
 }
 
 /// Polls the daemon's status until `condition` holds.

@@ -1,0 +1,429 @@
+//! Hostile peers against a real walkd: a local process that writes raw message bytes to walkd's
+//! services (`walk_tests::hostile`), an adapter that lies about time, joints or orientation, a
+//! client that floods or hogs the services. walkd must refuse or fault with the reason, keep
+//! running, and never command a joint outside its limits.
+
+use std::mem::offset_of;
+use std::time::{Duration, Instant};
+
+use kinematics::robot::Robot;
+use shm_types::{DaemonState, LinkState, SensorSample};
+use walk_tests::hostile::{
+    Feeder, PortHog, Raw, RawAdapter, RawClient, command_answers, command_q, standing_sample,
+};
+use walk_tests::{
+    config, connect_when_fresh, start_sim, start_walkd, unique_prefix, wait_for_status, wait_until,
+    walk_json,
+};
+
+const START: Duration = Duration::from_secs(20);
+const PERIOD: Duration = Duration::from_millis(2);
+const REPLY: Duration = Duration::from_secs(5);
+
+fn robot(name: &str) -> Robot {
+    Robot::load(&config(name), None).unwrap()
+}
+
+/// Every command inside the joint limits (no tolerance: limits are hard).
+fn assert_within_limits(robot: &Robot, commands: &[Raw<shm_types::JointCommand>]) {
+    let limits = robot.model.joint_limits();
+    let names = robot.model.joint_names();
+    for command in commands {
+        for (j, q) in command_q(command, limits.len()).iter().enumerate() {
+            assert!(
+                q.is_finite() && *q >= limits[j].lower && *q <= limits[j].upper,
+                "command for {} = {q} outside [{}, {}]",
+                names[j],
+                limits[j].lower,
+                limits[j].upper
+            );
+        }
+    }
+}
+
+/// Item 1: a control request whose command field holds no known command, and a sample whose
+/// flag bytes hold neither 0 nor 1, are refused with their reason; walkd lives on.
+#[test]
+fn unknown_enum_and_flag_values_are_refused_and_walkd_lives() {
+    let prefix = unique_prefix("hostile_wire");
+    let mut walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    let robot = robot("armar4");
+    let mut adapter = RawAdapter::open_when_ready(&prefix, START).unwrap();
+    let standing = standing_sample(&robot);
+    adapter.stream(&standing, PERIOD, Duration::from_millis(200));
+    let raw = RawClient::connect(&prefix).unwrap();
+    for value in [257u32, 0x8000_0000, 3] {
+        let (accepted, message) = raw
+            .control(value, REPLY)
+            .unwrap_or_else(|e| panic!("command {value}: {e}\n{}", walkd.log()));
+        assert!(!accepted, "command {value} was carried out: {message}");
+        assert!(message.contains(&value.to_string()), "{message}");
+        assert!(
+            walkd.is_running(),
+            "walkd died on command {value}\n{}",
+            walkd.log()
+        );
+    }
+
+    // has_imu = 2 with an IMU lying on its side: the sample is invalid, not "no IMU".
+    let imu = offset_of!(SensorSample, imu_orientation);
+    let half = std::f64::consts::FRAC_1_SQRT_2;
+    for _ in 0..20 {
+        adapter.publish(&standing, |raw| {
+            raw.put::<u8>(offset_of!(SensorSample, has_imu), 2);
+            raw.put::<[f64; 4]>(imu, [half, 0.0, 0.0, half]);
+        });
+        std::thread::sleep(PERIOD);
+    }
+    let client = walk_tests::connect(&prefix).unwrap();
+    let status = wait_for_status(&client, "a fault", REPLY, |s| s.state == DaemonState::Fault)
+        .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    assert!(status.fault.as_str().contains("has_imu"), "{status:?}");
+    assert!(walkd.is_running(), "{}", walkd.log());
+}
+
+/// Item 2: a sample stamped far in the future is refused and counted; the control thread does
+/// not wait for that time, answers hold at once, and SIGTERM ends it within a second.
+#[test]
+fn a_sample_stamped_in_the_future_does_not_freeze_the_control_thread() {
+    let prefix = unique_prefix("hostile_future");
+    let mut walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    let robot = robot("armar4");
+    let mut adapter = RawAdapter::open_when_ready(&prefix, START).unwrap();
+    let standing = standing_sample(&robot);
+    let answered = adapter.stream(&standing, PERIOD, Duration::from_millis(300));
+    assert!(
+        !answered.is_empty(),
+        "no command before the test\n{}",
+        walkd.log()
+    );
+
+    for future in [20_000_000_000u64, u64::MAX / 2, u64::MAX] {
+        adapter.publish(&standing, |raw| {
+            let now = shm_types::monotonic_ns();
+            raw.put(
+                offset_of!(SensorSample, timestamp_ns),
+                now.saturating_add(future),
+            );
+        });
+        std::thread::sleep(PERIOD);
+        // Ordinary samples again: each must be answered within a few periods.
+        let commands = adapter.stream(&standing, PERIOD, Duration::from_millis(300));
+        assert!(
+            commands.len() > 50,
+            "only {} commands in 300 ms after a sample stamped +{future} ns\n{}",
+            commands.len(),
+            walkd.log()
+        );
+    }
+    let client = walk_tests::connect(&prefix).unwrap();
+    let status = client.status().unwrap();
+    assert_eq!(status.link, LinkState::Fresh, "{status:?}");
+    let json = client::daemon_client::status_json(&status);
+    assert!(json["rejected_samples"].as_u64() >= Some(3), "{json}");
+    assert!(status.stale_periods < 1_000_000, "{status:?}");
+    let started = Instant::now();
+    client.control(shm_types::ControlCommand::Hold).unwrap();
+    assert!(started.elapsed() < Duration::from_secs(1));
+    walkd.signal(libc::SIGTERM);
+    let exit = walkd.wait_exit(Duration::from_secs(1));
+    assert_eq!(exit.and_then(|s| s.code()), Some(0), "{}", walkd.log());
+}
+
+/// Item 3: joints measured outside their limits are a fault naming the joint; no walk starts,
+/// and no command, hold included, leaves the limits.
+#[test]
+fn joints_measured_outside_their_limits_fault_and_commands_stay_inside() {
+    let prefix = unique_prefix("hostile_limits");
+    let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    let robot = robot("armar4");
+    let mut adapter = RawAdapter::open_when_ready(&prefix, START).unwrap();
+    let mut broken = standing_sample(&robot);
+    broken.q[..robot.model.dof()].fill(100.0);
+    let commands = adapter.stream(&broken, PERIOD, Duration::from_millis(300));
+    assert!(!commands.is_empty(), "{}", walkd.log());
+    assert_within_limits(&robot, &commands);
+    let client = walk_tests::connect(&prefix).unwrap();
+    let status = client.status().unwrap();
+    assert_eq!(status.state, DaemonState::Fault, "{status:?}");
+    let first = &robot.model.joint_names()[0];
+    assert!(status.fault.as_str().contains(first.as_str()), "{status:?}");
+
+    // A walk cannot start, and while samples keep coming nothing leaves the limits.
+    drop(adapter);
+    let feeder = Feeder::start(&prefix, broken, PERIOD).unwrap();
+    let (json, _) = walk_json("armar4", 0.3).unwrap();
+    let submit = client.submit_json(&json);
+    std::thread::sleep(Duration::from_millis(200));
+    assert_within_limits(&robot, &feeder.take_commands());
+    assert!(
+        submit.is_err(),
+        "a walk started with joints at 100 rad\n{}",
+        walkd.log()
+    );
+}
+
+/// Item 4: after the adapter restarts (kill -9, a new one), the first command holds the new
+/// robot's measured posture, not the posture before the crash; a tipping fault is acknowledged
+/// only once the robot stands upright, and says so until then.
+#[test]
+fn an_adapter_restart_holds_the_new_posture_and_tipping_can_be_acknowledged() {
+    let prefix = unique_prefix("hostile_restart");
+    let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    let sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
+    let robot = robot("armar4");
+    let dof = robot.model.dof();
+    let client = connect_when_fresh(&prefix, START).unwrap();
+    let (json, _) = walk_json("armar4", 1.0).unwrap();
+    client.submit_json(&json).unwrap();
+    std::thread::sleep(Duration::from_secs(3));
+    client.control(shm_types::ControlCommand::Hold).unwrap();
+    sim.signal(libc::SIGKILL);
+    wait_for_status(&client, "a stale link", REPLY, |s| {
+        s.link == LinkState::Stale
+    })
+    .unwrap();
+
+    // The "new robot": standing in its configured posture with the torso turned 0.3 rad.
+    let mut adapter = RawAdapter::open(&prefix).unwrap();
+    let mut fresh = standing_sample(&robot);
+    let torso = robot
+        .model
+        .joint_names()
+        .iter()
+        .position(|n| n == "torso_yaw_joint")
+        .unwrap();
+    fresh.q[torso] += 0.3;
+    let mut first = None;
+    let deadline = Instant::now() + REPLY;
+    while first.is_none() && Instant::now() < deadline {
+        let seq = adapter.publish(&fresh, |_| {});
+        std::thread::sleep(PERIOD);
+        first = adapter
+            .commands()
+            .into_iter()
+            .find(|c| command_answers(c) == seq);
+    }
+    let first = first.unwrap_or_else(|| panic!("no command after the restart\n{}", walkd.log()));
+    let error = command_q(&first, dof)
+        .iter()
+        .zip(&fresh.q[..dof])
+        .map(|(c, m)| (c - m).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        error < 1e-9,
+        "first command after the restart is {error} rad off the new posture"
+    );
+
+    // Tip the robot over: the IMU turns 0.5 rad from where leg odometry puts the base.
+    drop(adapter);
+    let feeder = Feeder::start(&prefix, fresh, PERIOD).unwrap();
+    let roll = |roll: f64| {
+        move |raw: &mut Raw<SensorSample>| {
+            raw.put::<u8>(offset_of!(SensorSample, has_imu), 1);
+            let (s, c) = (roll / 2.0).sin_cos();
+            raw.put::<[f64; 4]>(offset_of!(SensorSample, imu_orientation), [s, 0.0, 0.0, c]);
+        }
+    };
+    feeder.edit(roll(0.0));
+    std::thread::sleep(Duration::from_millis(200));
+    feeder.edit(roll(0.5));
+    let status =
+        wait_for_status(&client, "tipping", REPLY, |s| s.state == DaemonState::Fault).unwrap();
+    assert!(status.fault.as_str().contains("tipping"), "{status:?}");
+    // Lying: hold is refused and says what to do.
+    let raw = RawClient::connect(&prefix).unwrap();
+    let hold = shm_types::ControlCommand::Hold as u32;
+    let (accepted, message) = raw.control(hold, REPLY).unwrap();
+    assert!(
+        !accepted,
+        "hold acknowledged tipping while the robot lies: {message}"
+    );
+    assert!(message.contains("upright"), "{message}");
+    // Stood up again: hold acknowledges it.
+    feeder.edit(roll(0.0));
+    std::thread::sleep(Duration::from_millis(200));
+    let (accepted, message) = raw.control(hold, REPLY).unwrap();
+    assert!(accepted, "hold refused once upright: {message}");
+    std::thread::sleep(Duration::from_millis(200));
+    let status = client.status().unwrap();
+    assert_eq!(
+        status.state,
+        DaemonState::Holding,
+        "{status:?}\n{}",
+        walkd.log()
+    );
+}
+
+/// A stance file of `count` copies of one standing stance of `json` (a valid walk).
+fn repeated_stances(json: &str, count: usize) -> String {
+    let mut value: serde_json::Value = serde_json::from_str(json).unwrap();
+    let first = value["stances"][0].clone();
+    value["stances"] = serde_json::Value::Array(vec![first; count]);
+    value.to_string()
+}
+
+/// Item 5: submissions are bounded inside walkd (bytes before parsing, stances, busy before
+/// parsing) and the memory of a big walk is returned after it.
+#[test]
+fn submissions_are_bounded_and_busy_is_decided_before_parsing() {
+    let prefix = unique_prefix("hostile_size");
+    let walkd = start_walkd("armar4", &prefix, "lockstep", 500.0).unwrap();
+    let _sim = start_sim("armar4", &prefix, "lockstep", 500.0).unwrap();
+    let client = connect_when_fresh(&prefix, START).unwrap();
+    let raw = RawClient::connect(&prefix).unwrap();
+    let (json, _) = walk_json("armar4", 0.3).unwrap();
+
+    let spaces = vec![b' '; 40 << 20];
+    let started = Instant::now();
+    let (accepted, reason) = raw.submit(&spaces, REPLY).unwrap();
+    assert!(!accepted && reason.contains("bytes"), "{reason}");
+    assert!(
+        started.elapsed() < Duration::from_secs(2),
+        "{:?}",
+        started.elapsed()
+    );
+
+    let many = repeated_stances(&json, 12_000);
+    let (accepted, reason) = raw.submit(many.as_bytes(), REPLY).unwrap();
+    assert!(!accepted && reason.contains("stances"), "{reason}");
+
+    let rss_before = rss_kib(walkd.pid());
+    let big = repeated_stances(&json, 9_000);
+    let (accepted, reason) = raw.submit(big.as_bytes(), REPLY).unwrap();
+    assert!(accepted, "{reason}\n{}", walkd.log());
+    // While it executes, anything submitted is "busy", even what would not parse.
+    let (accepted, reason) = raw.submit(b"{ not json", REPLY).unwrap();
+    assert!(!accepted && reason.contains("busy"), "{reason}");
+    client.control(shm_types::ControlCommand::Abort).unwrap();
+    // A small walk replaces the big one, which walkd then frees.
+    client.submit_json(&json).unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    let rss_after = rss_kib(walkd.pid());
+    assert!(
+        rss_after < rss_before + 16 * 1024,
+        "walkd kept {} KiB after the big walk (before: {rss_before} KiB)",
+        rss_after
+    );
+}
+
+fn rss_kib(pid: u32) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .unwrap()
+}
+
+/// Item 6: a target outside the workspace the config allows is refused, naming the stance.
+#[test]
+fn targets_outside_the_workspace_are_refused() {
+    let prefix = unique_prefix("hostile_targets");
+    let _walkd = start_walkd("armar4", &prefix, "lockstep", 500.0).unwrap();
+    let _sim = start_sim("armar4", &prefix, "lockstep", 500.0).unwrap();
+    let client = connect_when_fresh(&prefix, START).unwrap();
+    let (json, _) = walk_json("armar4", 0.3).unwrap();
+    for x in [1e300, 1e6, 50.0] {
+        let mut value: serde_json::Value = serde_json::from_str(&json).unwrap();
+        let stances = value["stances"].as_array_mut().unwrap();
+        let swing = stances
+            .iter()
+            .position(|s| s["contacts"].as_array().unwrap().len() == 1)
+            .unwrap();
+        let foot = if stances[swing]["contacts"][0] == "left_foot" {
+            "right_foot"
+        } else {
+            "left_foot"
+        };
+        stances[swing]["targets"][foot]["translation"][0] = serde_json::json!(x);
+        match client.submit_json(&value.to_string()) {
+            Err(client::daemon_client::SubmitError::Refused(reason)) => {
+                assert!(reason.contains(&format!("stance {swing}")), "{reason}");
+                assert!(reason.contains(foot), "{reason}");
+            }
+            other => panic!("a {foot} target at x = {x} was not refused: {other:?}"),
+        }
+    }
+}
+
+/// Item 7: the first cause of a fault is kept until acknowledged, later effects are added to
+/// it, and a walk that ends `done` clears it.
+#[test]
+fn the_first_fault_cause_is_kept_and_done_clears_it() {
+    let prefix = unique_prefix("hostile_cause");
+    let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    let robot = robot("armar4");
+    let feeder = Feeder::start(&prefix, standing_sample(&robot), PERIOD).unwrap();
+    let client = walk_tests::connect(&prefix).unwrap();
+    wait_for_status(&client, "a fresh link", START, |s| {
+        s.link == LinkState::Fresh
+    })
+    .unwrap();
+    let (json, _) = walk_json("armar4", 0.3).unwrap();
+    client.submit_json(&json).unwrap();
+    std::thread::sleep(Duration::from_millis(100));
+    // One NaN sample, then the adapter goes silent.
+    feeder.edit(|raw| raw.put(offset_of!(SensorSample, q), f64::NAN));
+    std::thread::sleep(PERIOD * 2);
+    drop(feeder);
+    let status = wait_for_status(&client, "the fault", Duration::from_millis(500), |s| {
+        s.state == DaemonState::Fault
+    })
+    .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    assert!(
+        status.fault.as_str().contains("invalid measurement"),
+        "{status:?}"
+    );
+    let status = wait_for_status(&client, "a stale link", REPLY, |s| {
+        s.link == LinkState::Stale
+    })
+    .unwrap();
+    assert!(
+        status.fault.as_str().starts_with("invalid measurement"),
+        "the first cause was replaced: {status:?}"
+    );
+    assert!(status.fault.as_str().contains("stale"), "{status:?}");
+
+    let _sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
+    wait_for_status(&client, "a fresh link", START, |s| {
+        s.link == LinkState::Fresh
+    })
+    .unwrap();
+    client.control(shm_types::ControlCommand::Hold).unwrap();
+    let id = client.submit_json(&json).unwrap();
+    let done = client
+        .wait_for_sequence(id, Duration::from_secs(120), |_| {})
+        .unwrap();
+    assert_eq!(done.state, DaemonState::Done, "{done:?}\n{}", walkd.log());
+    assert!(
+        done.fault.is_empty(),
+        "an old fault stays beside done: {done:?}"
+    );
+}
+
+/// Item 8: one process holding many ports cannot lock monitoring out, and a second publisher
+/// on `sensors` is reported while the real adapter still connects.
+#[test]
+fn a_greedy_process_cannot_lock_out_monitoring_or_the_adapter() {
+    let prefix = unique_prefix("hostile_hog");
+    let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    walk_tests::wait_until("walkd's services", START, || {
+        walk_tests::connect(&prefix).ok()
+    })
+    .unwrap();
+    let hog = PortHog::take(&prefix, 8).unwrap();
+    assert_eq!(hog.taken.0, 8, "{:?}", hog.taken);
+    let _sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
+    let status = walk_tests::run_walkctl(&["status", "--service-prefix", &prefix])
+        .unwrap_or_else(|e| panic!("walkctl status: {e}\n{}", walkd.log()));
+    assert!(status.contains("state"), "{status}");
+    wait_until("walk-sim connected", START, || {
+        let client = walk_tests::connect(&prefix).ok()?;
+        (client.status().ok()?.link == LinkState::Fresh).then_some(())
+    })
+    .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    let client = walk_tests::connect(&prefix).unwrap();
+    let status = client.status().unwrap();
+    assert!(status.fault.as_str().contains("publishers"), "{status:?}");
+}

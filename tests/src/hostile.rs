@@ -1,0 +1,474 @@
+//! Hostile peers for the e2e tests: a process that talks to walkd's services with raw message
+//! bytes, as another program (or another language's bindings) could, instead of through the
+//! typed port wrappers of `shm-types`.
+//!
+//! [`Raw<T>`] has exactly the size, alignment and iceoryx2 type name of the message `T`, so it
+//! opens `T`'s services, but its bytes are written field by field at their offsets
+//! (`std::mem::offset_of!`), so a test can put any bit pattern where the contract expects an
+//! enum or a flag. [`RawAdapter`] publishes raw sensor samples and reads walkd's commands;
+//! [`RawClient`] sends raw control requests and submissions, and holds ports to exhaust a
+//! service's capacity.
+
+use std::mem::{MaybeUninit, offset_of, size_of};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, bail};
+use iceoryx2::port::client::Client;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use kinematics::robot::{EndEffector, Robot};
+use shm_types::{
+    ControlReply, ControlRequest, DaemonStatus, JointCommand, MAX_JOINTS, SensorSample, SubmitReply,
+};
+
+/// The bytes of a message `T`, written and read at field offsets; never read as a `T`.
+#[repr(C)]
+pub struct Raw<T> {
+    bytes: MaybeUninit<T>,
+}
+
+// SAFETY: `Raw<T>` has the layout of `T` (repr(C), one field) and `T` is a self-contained
+// shared-memory message; the type name is `T`'s, so both open the same services.
+unsafe impl<T: ZeroCopySend> ZeroCopySend for Raw<T> {
+    unsafe fn type_name() -> &'static str {
+        // SAFETY: forwards to the message type's own name.
+        unsafe { <T as ZeroCopySend>::type_name() }
+    }
+}
+
+impl<T> core::fmt::Debug for Raw<T> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "Raw<{}>", std::any::type_name::<T>())
+    }
+}
+
+impl<T: Copy> Raw<T> {
+    /// The bytes of `value`.
+    pub fn of(value: T) -> Self {
+        Self {
+            bytes: MaybeUninit::new(value),
+        }
+    }
+
+    /// Writes `value` at byte `offset`, whatever the field there is declared as.
+    pub fn put<V: Copy>(&mut self, offset: usize, value: V) {
+        assert!(
+            offset + size_of::<V>() <= size_of::<T>(),
+            "write past the message"
+        );
+        // SAFETY: in bounds (checked above); unaligned write of plain bytes into owned memory.
+        unsafe {
+            self.bytes
+                .as_mut_ptr()
+                .cast::<u8>()
+                .add(offset)
+                .cast::<V>()
+                .write_unaligned(value)
+        }
+    }
+
+    /// Reads a `V` at byte `offset` (any bit pattern is a valid `V` for the integer and float
+    /// types used here).
+    pub fn get<V: Copy>(&self, offset: usize) -> V {
+        assert!(
+            offset + size_of::<V>() <= size_of::<T>(),
+            "read past the message"
+        );
+        // SAFETY: in bounds (checked above); the bytes were written by a sender or `put`.
+        unsafe {
+            self.bytes
+                .as_ptr()
+                .cast::<u8>()
+                .add(offset)
+                .cast::<V>()
+                .read_unaligned()
+        }
+    }
+
+    /// Reads a `FixedText` field at `offset` (its `len: u32` then the bytes), lossily.
+    pub fn text(&self, offset: usize, capacity: usize) -> String {
+        let len = (self.get::<u32>(offset) as usize).min(capacity);
+        let bytes: Vec<u8> = (0..len).map(|i| self.get::<u8>(offset + 4 + i)).collect();
+        String::from_utf8_lossy(&bytes).into_owned()
+    }
+}
+
+impl<T: Copy> Clone for Raw<T> {
+    fn clone(&self) -> Self {
+        Self { bytes: self.bytes }
+    }
+}
+
+fn node(name: &str) -> anyhow::Result<Node<ipc::Service>> {
+    NodeBuilder::new()
+        .name(&NodeName::new(name)?)
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .context("creating an iceoryx2 node")
+}
+
+fn service_name(prefix: &str, kind: &str) -> anyhow::Result<ServiceName> {
+    Ok(ServiceName::new(&format!("{prefix}/{kind}"))?)
+}
+
+/// A sample of `robot` standing still in its configured posture, its weight shared by the feet.
+pub fn standing_sample(robot: &Robot) -> SensorSample {
+    let mut sample = SensorSample::ZERO;
+    let dof = robot.model.dof();
+    sample.joint_count = dof as u32;
+    sample.q[..dof].copy_from_slice(robot.standing.joints.as_slice());
+    let weight = robot.model.total_mass() * 9.81;
+    for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
+        sample.wrenches[foot as usize][2] = weight / 2.0;
+    }
+    sample
+}
+
+/// An adapter that publishes raw sensor samples and reads walkd's commands.
+pub struct RawAdapter {
+    publisher: Publisher<ipc::Service, Raw<SensorSample>, ()>,
+    notifier: Notifier<ipc::Service>,
+    commands: Subscriber<ipc::Service, Raw<JointCommand>, ()>,
+    seq: u64,
+    _node: Node<ipc::Service>,
+}
+
+impl RawAdapter {
+    /// Opens walkd's `sensors` and `commands` services under `prefix` (walkd created them).
+    pub fn open(prefix: &str) -> anyhow::Result<Self> {
+        let node = node("hostile-adapter")?;
+        let sensors = node
+            .service_builder(&service_name(prefix, "sensors")?)
+            .publish_subscribe::<Raw<SensorSample>>()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening sensors: {e:?}"))?;
+        let event = node
+            .service_builder(&service_name(prefix, "sensors")?)
+            .event()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening the sensors event: {e:?}"))?;
+        let commands = node
+            .service_builder(&service_name(prefix, "commands")?)
+            .publish_subscribe::<Raw<JointCommand>>()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening commands: {e:?}"))?;
+        Ok(Self {
+            publisher: sensors
+                .publisher_builder()
+                .create()
+                .map_err(|e| anyhow::anyhow!("publisher on sensors: {e:?}"))?,
+            notifier: event
+                .notifier_builder()
+                .create()
+                .map_err(|e| anyhow::anyhow!("notifier on sensors: {e:?}"))?,
+            commands: commands
+                .subscriber_builder()
+                .create()
+                .map_err(|e| anyhow::anyhow!("subscriber on commands: {e:?}"))?,
+            seq: 0,
+            _node: node,
+        })
+    }
+
+    /// Opens the services once walkd created them (waits up to `timeout`).
+    pub fn open_when_ready(prefix: &str, timeout: Duration) -> anyhow::Result<Self> {
+        crate::wait_until("walkd's sensor and command services", timeout, || {
+            Self::open(prefix).ok()
+        })
+    }
+
+    /// Publishes `sample` with the next sequence number, stamped now, after `edit` changed its
+    /// raw bytes; returns the sequence number.
+    pub fn publish(
+        &mut self,
+        sample: &SensorSample,
+        edit: impl FnOnce(&mut Raw<SensorSample>),
+    ) -> u64 {
+        let mut raw = Raw::of(*sample);
+        raw.put(
+            offset_of!(SensorSample, timestamp_ns),
+            shm_types::monotonic_ns(),
+        );
+        edit(&mut raw);
+        self.publish_raw(raw)
+    }
+
+    /// Publishes `raw` with the next sequence number (its other bytes as they are; a zero
+    /// timestamp is replaced by now); returns the sequence number.
+    pub fn publish_raw(&mut self, mut raw: Raw<SensorSample>) -> u64 {
+        self.seq += 1;
+        raw.put(offset_of!(SensorSample, seq), self.seq);
+        if raw.get::<u64>(offset_of!(SensorSample, timestamp_ns)) == 0 {
+            raw.put(
+                offset_of!(SensorSample, timestamp_ns),
+                shm_types::monotonic_ns(),
+            );
+        }
+        let loan = self.publisher.loan_uninit().expect("loan a sample");
+        loan.write_payload(raw).send().expect("send a sample");
+        self.notifier.notify().expect("notify");
+        self.seq
+    }
+
+    /// Every command received since the last call, oldest first.
+    pub fn commands(&self) -> Vec<Raw<JointCommand>> {
+        let mut out = Vec::new();
+        while let Some(sample) = self.commands.receive().expect("receive commands") {
+            out.push(sample.payload().clone());
+        }
+        out
+    }
+
+    /// Publishes `sample` every `period` for `duration` (stamped now, otherwise unchanged),
+    /// collecting the commands that come back.
+    pub fn stream(
+        &mut self,
+        sample: &SensorSample,
+        period: Duration,
+        duration: Duration,
+    ) -> Vec<Raw<JointCommand>> {
+        let start = Instant::now();
+        let mut commands = Vec::new();
+        while start.elapsed() < duration {
+            self.publish(sample, |_| {});
+            std::thread::sleep(period);
+            commands.extend(self.commands());
+        }
+        commands
+    }
+}
+
+/// A [`RawAdapter`] on a thread of its own that publishes a sample every period (the current
+/// template, freshly numbered and stamped) and keeps every command that comes back, so a test
+/// can make blocking requests meanwhile (iceoryx2 ports cannot move between threads).
+pub struct Feeder {
+    template: Arc<Mutex<Raw<SensorSample>>>,
+    commands: Arc<Mutex<Vec<Raw<JointCommand>>>>,
+    stop: Arc<AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Feeder {
+    /// Starts publishing `sample` every `period` on walkd's services under `prefix`.
+    pub fn start(prefix: &str, sample: SensorSample, period: Duration) -> anyhow::Result<Self> {
+        let template = Arc::new(Mutex::new(Raw::of(sample)));
+        let commands = Arc::new(Mutex::new(Vec::new()));
+        let stop = Arc::new(AtomicBool::new(false));
+        let (ready_tx, ready_rx) = std::sync::mpsc::channel();
+        let thread = {
+            let (prefix, template, commands, stop) = (
+                prefix.to_owned(),
+                template.clone(),
+                commands.clone(),
+                stop.clone(),
+            );
+            std::thread::spawn(move || {
+                let mut adapter =
+                    match RawAdapter::open_when_ready(&prefix, Duration::from_secs(20)) {
+                        Ok(adapter) => {
+                            let _ = ready_tx.send(Ok(()));
+                            adapter
+                        }
+                        Err(error) => {
+                            let _ = ready_tx.send(Err(error));
+                            return;
+                        }
+                    };
+                while !stop.load(Ordering::Relaxed) {
+                    let raw = template.lock().unwrap().clone();
+                    adapter.publish_raw(raw);
+                    std::thread::sleep(period);
+                    commands.lock().unwrap().extend(adapter.commands());
+                }
+            })
+        };
+        ready_rx.recv()??;
+        Ok(Self {
+            template,
+            commands,
+            stop,
+            thread: Some(thread),
+        })
+    }
+
+    /// Changes the bytes of the samples published from now on.
+    pub fn edit(&self, edit: impl FnOnce(&mut Raw<SensorSample>)) {
+        edit(&mut self.template.lock().unwrap());
+    }
+
+    /// The commands received since the last call.
+    pub fn take_commands(&self) -> Vec<Raw<JointCommand>> {
+        std::mem::take(&mut *self.commands.lock().unwrap())
+    }
+}
+
+impl Drop for Feeder {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
+}
+
+/// The `q_des` of a command (its first `dof` entries).
+pub fn command_q(command: &Raw<JointCommand>, dof: usize) -> Vec<f64> {
+    let q: [f64; MAX_JOINTS] = command.get(offset_of!(JointCommand, q_des));
+    q[..dof].to_vec()
+}
+
+/// The sample sequence number a command answers.
+pub fn command_answers(command: &Raw<JointCommand>) -> u64 {
+    command.get(offset_of!(JointCommand, answers_seq))
+}
+
+/// A client that sends raw control requests and raw submissions.
+pub struct RawClient {
+    control: Client<ipc::Service, Raw<ControlRequest>, (), Raw<ControlReply>, ()>,
+    stances: Client<ipc::Service, [u8], (), Raw<SubmitReply>, ()>,
+    _node: Node<ipc::Service>,
+}
+
+impl RawClient {
+    /// Opens walkd's `control` and `stances` services under `prefix`.
+    pub fn connect(prefix: &str) -> anyhow::Result<Self> {
+        let node = node("hostile-client")?;
+        let control = node
+            .service_builder(&service_name(prefix, "control")?)
+            .request_response::<Raw<ControlRequest>, Raw<ControlReply>>()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening control: {e:?}"))?;
+        let stances = node
+            .service_builder(&service_name(prefix, "stances")?)
+            .request_response::<[u8], Raw<SubmitReply>>()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening stances: {e:?}"))?;
+        Ok(Self {
+            control: control
+                .client_builder()
+                .create()
+                .map_err(|e| anyhow::anyhow!("client on control: {e:?}"))?,
+            stances: stances
+                .client_builder()
+                .initial_max_slice_len(1 << 16)
+                .allocation_strategy(AllocationStrategy::PowerOfTwo)
+                .create()
+                .map_err(|e| anyhow::anyhow!("client on stances: {e:?}"))?,
+            _node: node,
+        })
+    }
+
+    /// Sends a control request whose command field holds `command` (any value) and waits for
+    /// the reply: (accepted, message).
+    pub fn control(&self, command: u32, timeout: Duration) -> anyhow::Result<(bool, String)> {
+        let mut request = Raw::of(ControlRequest::default());
+        request.put(offset_of!(ControlRequest, command), command);
+        let pending = self
+            .control
+            .loan_uninit()
+            .map_err(|e| anyhow::anyhow!("loan: {e:?}"))?
+            .write_payload(request)
+            .send()
+            .map_err(|e| anyhow::anyhow!("send: {e:?}"))?;
+        let reply = wait(timeout, || {
+            pending
+                .receive()
+                .ok()
+                .flatten()
+                .map(|r| r.payload().clone())
+        })?;
+        Ok((
+            reply.get::<u8>(offset_of!(ControlReply, accepted)) != 0,
+            reply.text(offset_of!(ControlReply, message), 160),
+        ))
+    }
+
+    /// Submits `bytes` (no size check on this side) and waits for the verdict: (accepted, reason).
+    pub fn submit(&self, bytes: &[u8], timeout: Duration) -> anyhow::Result<(bool, String)> {
+        let pending = self
+            .stances
+            .loan_slice_uninit(bytes.len())
+            .map_err(|e| anyhow::anyhow!("loan {} bytes: {e:?}", bytes.len()))?
+            .write_from_slice(bytes)
+            .send()
+            .map_err(|e| anyhow::anyhow!("send: {e:?}"))?;
+        let reply = wait(timeout, || {
+            pending
+                .receive()
+                .ok()
+                .flatten()
+                .map(|r| r.payload().clone())
+        })?;
+        Ok((
+            reply.get::<u8>(offset_of!(SubmitReply, accepted)) != 0,
+            reply.text(offset_of!(SubmitReply, reason), 512),
+        ))
+    }
+}
+
+/// Holds as many ports of walkd's `control` clients and `status` subscribers as iceoryx2 lets
+/// one process take (at most `limit` each), as a greedy or leaking process would.
+pub struct PortHog {
+    _control: Vec<Client<ipc::Service, Raw<ControlRequest>, (), Raw<ControlReply>, ()>>,
+    _status: Vec<Subscriber<ipc::Service, Raw<DaemonStatus>, ()>>,
+    _sensors: Vec<Publisher<ipc::Service, Raw<SensorSample>, ()>>,
+    /// Ports taken: (control clients, status subscribers, sensor publishers).
+    pub taken: (usize, usize, usize),
+    _node: Node<ipc::Service>,
+}
+
+impl PortHog {
+    /// Takes up to `limit` ports of each kind under `prefix`.
+    pub fn take(prefix: &str, limit: usize) -> anyhow::Result<Self> {
+        let node = node("hostile-hog")?;
+        let control = node
+            .service_builder(&service_name(prefix, "control")?)
+            .request_response::<Raw<ControlRequest>, Raw<ControlReply>>()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening control: {e:?}"))?;
+        let status = node
+            .service_builder(&service_name(prefix, "status")?)
+            .publish_subscribe::<Raw<DaemonStatus>>()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening status: {e:?}"))?;
+        let sensors = node
+            .service_builder(&service_name(prefix, "sensors")?)
+            .publish_subscribe::<Raw<SensorSample>>()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening sensors: {e:?}"))?;
+        let control: Vec<_> = (0..limit)
+            .map_while(|_| control.client_builder().create().ok())
+            .collect();
+        let status: Vec<_> = (0..limit)
+            .map_while(|_| status.subscriber_builder().create().ok())
+            .collect();
+        let sensors: Vec<_> = (0..limit)
+            .map_while(|_| sensors.publisher_builder().create().ok())
+            .collect();
+        Ok(Self {
+            taken: (control.len(), status.len(), sensors.len()),
+            _control: control,
+            _status: status,
+            _sensors: sensors,
+            _node: node,
+        })
+    }
+}
+
+/// Polls `poll` every millisecond until it yields a value or `timeout` passes.
+fn wait<T>(timeout: Duration, mut poll: impl FnMut() -> Option<T>) -> anyhow::Result<T> {
+    let start = Instant::now();
+    loop {
+        if let Some(value) = poll() {
+            return Ok(value);
+        }
+        if start.elapsed() > timeout {
+            bail!("no reply within {timeout:?}");
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}
