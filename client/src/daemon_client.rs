@@ -4,9 +4,10 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
+use kinematics::ConfigFile;
 use shm_types::{
     ClientPorts, ControlCommand, DaemonState, DaemonStatus, LatencySummary, RuntimeConfig,
-    ServiceNames,
+    ServiceNames, ShmError,
 };
 
 /// How long a request to the daemon may take before it counts as unanswered.
@@ -32,7 +33,8 @@ impl DaemonTarget {
         let Some(config) = &self.config else {
             bail!("say which daemon: pass --config CONFIG or --service-prefix PREFIX");
         };
-        Ok(RuntimeConfig::from_config_file(config)?.service_prefix)
+        let file = ConfigFile::load(config)?;
+        Ok(RuntimeConfig::from_section(file.section("runtime"), &file.origin())?.service_prefix)
     }
 }
 
@@ -53,10 +55,17 @@ pub enum SubmitError {
 }
 
 impl DaemonClient {
-    /// Connects to the daemon serving `prefix`; fails with a clear message if none does.
+    /// Connects to the daemon serving `prefix`; fails at once with a clear message if none
+    /// does (no service, or services left by a daemon that is gone).
     pub fn connect(prefix: &str) -> anyhow::Result<Self> {
         let names = ServiceNames::new(prefix)?;
         let ports = ClientPorts::connect(&names, "walkctl")?;
+        if !ports.daemon_present() {
+            bail!(
+                "no walkd serves `{prefix}`: its services exist, but no daemon process is \
+                 attached to them (is walkd running with this service prefix?)"
+            );
+        }
         Ok(Self { ports })
     }
 
@@ -65,12 +74,17 @@ impl DaemonClient {
         self.ports.daemon_present()
     }
 
-    /// The daemon's current status (asked for directly, not waiting for a publication).
+    /// The daemon's current status: asked for directly, or, when every `control` slot is taken
+    /// by other processes, the next one the daemon publishes.
     pub fn status(&self) -> anyhow::Result<DaemonStatus> {
-        Ok(self
-            .ports
-            .control(ControlCommand::Query, REQUEST_TIMEOUT)?
-            .status)
+        match self.ports.control(ControlCommand::Query, REQUEST_TIMEOUT) {
+            Ok(reply) => Ok(reply.status),
+            Err(full @ ShmError::ServiceFull { .. }) => self
+                .ports
+                .next_status(Duration::from_secs(2))
+                .with_context(|| format!("{full}; nor did a published status arrive")),
+            Err(other) => Err(other.into()),
+        }
     }
 
     /// The next published status (waits up to `timeout`).
@@ -81,7 +95,7 @@ impl DaemonClient {
     /// Submits a post-processed sequence (JSON); returns its id once it started executing.
     pub fn submit_json(&self, json: &str) -> Result<u64, SubmitError> {
         let reply = self.ports.submit(json.as_bytes(), REQUEST_TIMEOUT)?;
-        if reply.accepted {
+        if reply.accepted.is_set() {
             Ok(reply.sequence_id)
         } else {
             Err(SubmitError::Refused(reply.reason.as_str().to_owned()))
@@ -91,7 +105,7 @@ impl DaemonClient {
     /// Sends hold or abort; returns the status after it was carried out.
     pub fn control(&self, command: ControlCommand) -> anyhow::Result<DaemonStatus> {
         let reply = self.ports.control(command, REQUEST_TIMEOUT)?;
-        if !reply.accepted {
+        if !reply.accepted.is_set() {
             bail!(
                 "walkd did not carry out {}: {}",
                 command.name(),
@@ -158,11 +172,13 @@ pub fn status_json(status: &DaemonStatus) -> serde_json::Value {
         "right_foot": status.right_foot,
         "fault": status.fault.as_str(),
         "adapter_link": status.link.name(),
-        "adapter_holding": status.adapter_holding,
+        "adapter_holding": status.adapter_holding.is_set(),
         "ticks": status.ticks,
         "deadline_misses": status.deadline_misses,
         "stale_periods": status.stale_periods,
         "watchdog_trips": status.watchdog_trips,
+        "rejected_samples": status.rejected_samples,
+        "last_rejection": status.last_rejection.as_str(),
         "tick_us": latency_json(&status.tick_us),
         "latency_us": latency_json(&status.latency_us),
         "jitter_us": latency_json(&status.jitter_us),
@@ -183,7 +199,7 @@ pub fn status_text(status: &DaemonStatus) -> String {
         status.stance_count,
         status.phase,
         status.link.name(),
-        if status.adapter_holding {
+        if status.adapter_holding.is_set() {
             " (adapter holding)"
         } else {
             ""

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
+use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::{ClockMode, DaemonState, DaemonStatus, LatencySummary, RuntimeConfig};
 
@@ -118,10 +119,11 @@ pub struct DemoOutcome {
 impl DemoOutcome {
     /// `done`, the fault / state the walk ended in, or `fell at <t> s (daemon: ...)`.
     pub fn outcome(&self) -> String {
-        let daemon = match self.status.state {
-            DaemonState::Done => "done".to_owned(),
-            DaemonState::Fault => format!("fault: {}", self.status.fault),
-            other => format!("{}: {}", other.name(), self.status.fault),
+        let state = self.status.state;
+        let daemon = if state == DaemonState::Done {
+            "done".to_owned()
+        } else {
+            format!("{}: {}", state.name(), self.status.fault)
         };
         judged_outcome(self.fell_at_s, &daemon)
     }
@@ -144,6 +146,7 @@ impl DemoOutcome {
             "fell_at_s": self.fell_at_s,
             "max_tilt_rad": self.max_tilt_rad,
             "deadline_misses": self.status.deadline_misses,
+            "stale_periods": self.status.stale_periods,
             "tick_us": tick(&self.status.tick_us),
             "latency_us": tick(&self.status.latency_us),
             "clock": self.status.clock.name(),
@@ -225,12 +228,13 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         Some(config) => config.clone(),
         None => default_config(args.robot)?,
     };
-    let runtime = RuntimeConfig::from_config_file(&config)?;
+    let file = ConfigFile::load(&config)?;
+    let runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())?;
     let prefix = args
         .service_prefix
         .clone()
         .unwrap_or(runtime.service_prefix);
-    let robot = Robot::load(&config, args.urdf.as_deref())?;
+    let robot = Robot::from_config(&file, args.urdf.as_deref())?;
     let (json, stance_count) = walk_sequence(&robot, &config, args.distance, args.seed)?;
 
     let mut children = Children(Vec::new());

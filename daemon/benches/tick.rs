@@ -91,8 +91,9 @@ impl Loop {
                 imu_orientation: Some(m.base_orientation),
             };
             let started = Instant::now();
-            self.controller.tick(&measurement, dt, &mut self.command);
+            let commanded = self.controller.tick(&measurement, dt, &mut self.command);
             total += started.elapsed();
+            assert!(commanded, "the simulator's measurements are valid");
             self.sim
                 .step(
                     self.command.q_des.as_slice(),

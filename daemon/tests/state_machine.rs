@@ -3,7 +3,9 @@
 
 mod walk_support;
 
-use daemon::controller::{CommandMode, ControllerState, FaultCode, Phase};
+use daemon::controller::{
+    CommandMode, ControllerState, FaultCode, MeasurementFault, Phase, StartRefusal,
+};
 use kinematics::robot::EndEffector;
 use walk_support::Harness;
 
@@ -170,7 +172,8 @@ fn start_is_refused_while_executing_and_in_fault_until_reset() {
     let config = walk_support::controller_config("jvrc1");
     let sequence = walk_support::synthetic_walk(&h.robot, 1, 0.05, false);
     let prepared = daemon::controller::Controller::prepare(&h.robot, &config, &sequence).unwrap();
-    let refused = h.controller.start(Box::new(prepared)).unwrap_err();
+    let (refused, why) = h.controller.start(Box::new(prepared)).unwrap_err();
+    assert_eq!(why, StartRefusal::Busy);
     // A non-finite measurement faults the controller; it then refuses until reset.
     let q: Vec<f64> = h.sim.measurement().q.iter().map(|_| f64::NAN).collect();
     let measurement = daemon::controller::Measurement {
@@ -180,14 +183,22 @@ fn start_is_refused_while_executing_and_in_fault_until_reset() {
         imu_orientation: None,
     };
     let before = h.command.q_des.clone();
-    h.controller.tick(&measurement, h.dt, &mut h.command);
+    assert!(h.controller.tick(&measurement, h.dt, &mut h.command));
     assert_eq!(h.controller.status().state, ControllerState::Fault);
-    assert_eq!(h.controller.status().fault, FaultCode::InvalidMeasurement);
+    assert_eq!(
+        h.controller.status().fault,
+        FaultCode::InvalidMeasurement(MeasurementFault::NonFiniteAngle(0))
+    );
     assert_eq!(h.command.q_des, before, "holds the last safe command");
     assert_eq!(h.command.mode, CommandMode::Hold);
-    let refused = h.controller.start(refused).unwrap_err();
-    h.controller.reset();
+    let (refused, why) = h.controller.start(refused).unwrap_err();
+    assert_eq!(why, StartRefusal::Faulted);
+    h.controller.reset().unwrap();
     assert_eq!(h.controller.status().state, ControllerState::Holding);
+    // The last measurement was invalid: a walk starts only from a valid one.
+    let (refused, why) = h.controller.start(refused).unwrap_err();
+    assert_eq!(why, StartRefusal::NoMeasurement);
+    h.tick();
     assert!(h.controller.start(refused).is_ok());
     for _ in 0..MAX_TICKS {
         h.tick();
@@ -235,7 +246,7 @@ fn an_imu_that_disagrees_with_leg_odometry_is_a_tipping_fault_that_holds() {
             imu_orientation: Some(roll(angle)),
         };
         let before = h.command.q_des.clone();
-        h.controller.tick(&measurement, h.dt, &mut h.command);
+        assert!(h.controller.tick(&measurement, h.dt, &mut h.command));
         if tipping {
             assert_eq!(h.controller.status().state, ControllerState::Fault);
             assert_eq!(h.controller.status().fault, FaultCode::Tipping);

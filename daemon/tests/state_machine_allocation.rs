@@ -52,9 +52,10 @@ fn controller_tick_does_not_allocate() {
             };
             ALLOCATIONS.store(0, Ordering::Relaxed);
             COUNTING.store(true, Ordering::Relaxed);
-            h.controller.tick(&measurement, h.dt, &mut h.command);
+            let commanded = h.controller.tick(&measurement, h.dt, &mut h.command);
             COUNTING.store(false, Ordering::Relaxed);
             allocations += ALLOCATIONS.load(Ordering::Relaxed);
+            assert!(commanded, "{robot}: the simulator's measurements are valid");
             h.sim
                 .step(
                     h.command.q_des.as_slice(),

@@ -12,6 +12,7 @@
 //! - The CoM Jacobian (3 × (6+n)) maps ν to ċ in the world frame.
 //! - Mimic joints are treated as fixed at their offset; they are not in the joint vector.
 
+pub mod config_file;
 pub mod configuration;
 pub mod ik;
 pub mod kinematics;
@@ -20,6 +21,7 @@ pub mod robot;
 
 pub use nalgebra::{DMatrix, DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
 
+pub use config_file::{ConfigFile, ConfigFileError};
 pub use configuration::Configuration;
 pub use ik::{IkError, IkOptions, IkSolution, IkSolver, IkTarget};
 pub use kinematics::{FrameSet, Kinematics};

@@ -33,6 +33,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use serde::Deserialize;
 
+use crate::config_file::{ConfigFile, ConfigFileError};
 use crate::configuration::Configuration;
 use crate::kinematics::Kinematics;
 use crate::model::{FrameId, LinkId, Model, ModelError, pose_from_xyz_rpy};
@@ -129,15 +130,10 @@ pub struct Robot {
 /// Why a robot config cannot be loaded; each variant names the file and key.
 #[derive(Debug, thiserror::Error)]
 pub enum RobotError {
-    /// The config file could not be read.
-    #[error("cannot read robot config {path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
-    },
-    /// The TOML does not parse or the `[robot]` section does not match the schema.
+    /// The config file could not be read or parsed.
+    #[error(transparent)]
+    File(#[from] ConfigFileError),
+    /// The `[robot]` section is missing or does not match the schema.
     #[error("{path}: invalid [robot] section: {message}")]
     Schema {
         /// The file.
@@ -157,12 +153,12 @@ pub enum RobotError {
         robot: String,
     },
     /// The URDF is invalid.
-    #[error("{urdf}: {source}")]
+    #[error("{urdf}: {error}")]
     Model {
         /// The URDF file.
         urdf: PathBuf,
         /// What is wrong with it.
-        source: ModelError,
+        error: ModelError,
     },
     /// A key names a link the model does not have.
     #[error("{path}: robot.{key}: link '{name}' is not in the model")]
@@ -245,33 +241,36 @@ struct RobotSection {
     standing: BTreeMap<String, f64>,
 }
 
-/// The config file as far as this crate is concerned (other sections belong to other crates).
-#[derive(Debug, Deserialize)]
-struct ConfigFile {
-    robot: RobotSection,
-}
-
 /// Soles count as flat when their normals are within this angle (rad) of vertical and their
 /// heights agree to this distance (m).
 const FLAT_TOLERANCE: f64 = 1e-6;
 
 impl Robot {
-    /// Loads `config`'s `[robot]` section and its model (`urdf_override` wins over the config's
-    /// `urdf`; a relative config path is taken relative to the config file).
+    /// Loads the config file at `config`, then the robot from it (see [`Robot::from_config`]).
     pub fn load(config: &Path, urdf_override: Option<&Path>) -> Result<Robot, RobotError> {
-        let text = std::fs::read_to_string(config).map_err(|source| RobotError::Io {
+        Self::from_config(&ConfigFile::load(config)?, urdf_override)
+    }
+
+    /// The robot of `file`'s `[robot]` section and its model (`urdf_override` wins over the
+    /// section's `urdf`; a relative path is taken relative to the config file).
+    pub fn from_config(
+        file: &ConfigFile,
+        urdf_override: Option<&Path>,
+    ) -> Result<Robot, RobotError> {
+        let config = file.path();
+        let schema = |message: String| RobotError::Schema {
             path: config.to_owned(),
-            source,
-        })?;
-        let section = toml::from_str::<ConfigFile>(&text)
-            .map_err(|error| RobotError::Schema {
-                path: config.to_owned(),
-                message: error.to_string(),
-            })?
-            .robot;
+            message,
+        };
+        let section: RobotSection = file
+            .section("robot")
+            .ok_or_else(|| schema("the section is missing".to_owned()))?
+            .clone()
+            .try_into()
+            .map_err(|error: toml::de::Error| schema(error.message().to_owned()))?;
         let urdf = match (urdf_override, &section.urdf) {
             (Some(path), _) => path.to_owned(),
-            (None, Some(relative)) => config.parent().unwrap_or(Path::new(".")).join(relative),
+            (None, Some(relative)) => file.resolve(relative),
             (None, None) => {
                 return Err(RobotError::MissingUrdf {
                     path: config.to_owned(),
@@ -279,9 +278,9 @@ impl Robot {
                 });
             }
         };
-        let model = Model::from_urdf_path(&urdf).map_err(|source| RobotError::Model {
+        let model = Model::from_urdf_path(&urdf).map_err(|error| RobotError::Model {
             urdf: urdf.clone(),
-            source,
+            error,
         })?;
         Loader {
             path: config,

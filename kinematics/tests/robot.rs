@@ -295,3 +295,34 @@ fn hrp4_config_loads_with_a_user_supplied_urdf() {
     );
     assert_soles_flat(&robot);
 }
+
+/// The error and its sources joined as `anyhow`'s `{:#}` prints them (what the binaries log).
+fn chain(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut source = error.source();
+    while let Some(cause) = source {
+        text.push_str(": ");
+        text.push_str(&cause.to_string());
+        source = cause.source();
+    }
+    text
+}
+
+#[test]
+fn a_missing_urdf_is_named_once() {
+    let path = edited_jvrc1(|t| t.replace("jvrc1.urdf", "no-such.urdf"), "missing_urdf");
+    let message = chain(&Robot::load(&path, None).unwrap_err());
+    assert_eq!(message.matches("no-such.urdf").count(), 1, "{message}");
+    assert_eq!(
+        message.matches("No such file").count(),
+        1,
+        "the cause repeats: {message}"
+    );
+}
+
+#[test]
+fn an_unknown_section_is_refused() {
+    let path = edited_jvrc1(|t| t.replace("[runtime]", "[runtme]"), "section");
+    let message = load_error(&path);
+    assert!(message.contains("unknown section [runtme]"), "{message}");
+}

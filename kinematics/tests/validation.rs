@@ -277,3 +277,15 @@ fn frames_are_validated() {
         Err(ModelError::FrameNotFinite(_))
     ));
 }
+
+#[test]
+fn an_actuated_joint_with_a_zero_velocity_limit_is_refused() {
+    let mut parts = chain();
+    parts[4] = parts[4].replace(r#"velocity="2""#, r#"velocity="0""#);
+    let error = error_of(&parts);
+    assert!(
+        matches!(error, ModelError::ZeroVelocityLimit { ref joint, .. } if joint == "j2"),
+        "{error}"
+    );
+    assert!(error.to_string().contains("'j2'"), "{error}");
+}

@@ -1,7 +1,6 @@
 //! The `[runtime]` section of a robot config: what the daemon and its adapters must agree on
-//! (service prefix, rate, watchdogs) plus the daemon's real-time options.
-
-use std::path::{Path, PathBuf};
+//! (service prefix, rate, watchdogs), the daemon's real-time options and its submission limits.
+//! The file itself is read once by `kinematics::ConfigFile`, which hands this crate the section.
 
 use serde::Deserialize;
 
@@ -37,6 +36,12 @@ pub struct RuntimeConfig {
     /// half a period or more: never sleep, which takes a core of its own).
     #[serde(default)]
     pub spin_us: u32,
+    /// Largest submission (JSON bytes) walkd reads; a larger one is refused before parsing.
+    #[serde(default = "default_max_submission_bytes")]
+    pub max_submission_bytes: usize,
+    /// Most stances a submitted sequence may have; counted before the sequence is built.
+    #[serde(default = "default_max_stances")]
+    pub max_stances: usize,
 }
 
 fn default_rate_hz() -> f64 {
@@ -51,70 +56,45 @@ fn default_lockstep_timeout_ms() -> u64 {
 fn default_status_rate_hz() -> f64 {
     20.0
 }
+fn default_max_submission_bytes() -> usize {
+    crate::MAX_SEQUENCE_BYTES
+}
+/// About 15 km of the slowest generated walk (26 stances per metre).
+fn default_max_stances() -> usize {
+    10_000
+}
 
 /// Why `[runtime]` could not be read; names the file and the key.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
-    /// The file could not be read.
-    #[error("cannot read {path}")]
-    Read {
-        /// The config file.
-        path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
-    },
-    /// The file is not valid TOML.
-    #[error("{path} is not valid TOML: {message}")]
-    Toml {
-        /// The config file.
-        path: PathBuf,
-        /// The parser's message.
-        message: String,
-    },
     /// The `[runtime]` section is missing.
-    #[error("{path}: missing section [runtime]")]
+    #[error("{origin}: missing section [runtime]")]
     MissingSection {
         /// The config file.
-        path: PathBuf,
+        origin: String,
     },
-    /// A key of `[runtime]` is unknown, missing or of the wrong type.
-    #[error("{path}: [runtime]: {message}")]
+    /// A key of `[runtime]` is unknown, missing, of the wrong type or out of range.
+    #[error("{origin}: [runtime]: {message}")]
     Invalid {
         /// The config file.
-        path: PathBuf,
+        origin: String,
         /// What is wrong, naming the key.
         message: String,
     },
 }
 
 impl RuntimeConfig {
-    /// Reads `[runtime]` from a robot config file.
-    pub fn from_config_file(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-            path: path.to_owned(),
-            source,
+    /// Reads the `[runtime]` section (`None`: the file has none); `origin` names the file.
+    pub fn from_section(section: Option<&toml::Value>, origin: &str) -> Result<Self, ConfigError> {
+        let section = section.ok_or_else(|| ConfigError::MissingSection {
+            origin: origin.to_owned(),
         })?;
-        Self::from_toml_str(&text, path)
-    }
-
-    /// Reads `[runtime]` from the text of a robot config; `path` only names it in errors.
-    pub fn from_toml_str(text: &str, path: &Path) -> Result<Self, ConfigError> {
-        let mut table: toml::Table =
-            text.parse()
-                .map_err(|e: toml::de::Error| ConfigError::Toml {
-                    path: path.to_owned(),
-                    message: e.to_string(),
-                })?;
-        let section = table
-            .remove("runtime")
-            .ok_or_else(|| ConfigError::MissingSection {
-                path: path.to_owned(),
-            })?;
         let invalid = |message: String| ConfigError::Invalid {
-            path: path.to_owned(),
+            origin: origin.to_owned(),
             message,
         };
         let config: Self = section
+            .clone()
             .try_into()
             .map_err(|e: toml::de::Error| invalid(e.message().to_owned()))?;
         config.validate().map_err(invalid)?;
@@ -142,6 +122,9 @@ impl RuntimeConfig {
         {
             return Err(format!("fifo_priority = {priority} must be in 1..=99"));
         }
+        if self.max_submission_bytes == 0 || self.max_stances == 0 {
+            return Err("max_submission_bytes and max_stances must be at least 1".to_owned());
+        }
         crate::ServiceNames::new(&self.service_prefix)
             .map_err(|e| format!("service_prefix: {e}"))?;
         Ok(())
@@ -153,7 +136,8 @@ mod tests {
     use super::*;
 
     fn parse(text: &str) -> Result<RuntimeConfig, ConfigError> {
-        RuntimeConfig::from_toml_str(text, Path::new("robot.toml"))
+        let table: toml::Table = text.parse().unwrap();
+        RuntimeConfig::from_section(table.get("runtime"), "robot.toml")
     }
 
     #[test]

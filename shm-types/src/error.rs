@@ -28,6 +28,20 @@ pub enum ShmError {
         /// The missing service.
         service: String,
     },
+    /// Every port of a service is taken (by other processes: iceoryx2 limits ports per
+    /// service, not per process).
+    #[error(
+        "all {limit} {port} slots of `{service}` are taken by other processes; stop the \
+         process that holds them (`walkctl` ports are released when it exits)"
+    )]
+    ServiceFull {
+        /// The service.
+        service: String,
+        /// `client`, `subscriber` or `publisher`.
+        port: &'static str,
+        /// The service's limit.
+        limit: usize,
+    },
     /// The daemon did not answer in time.
     #[error("no answer on `{service}` within {timeout_ms} ms")]
     Timeout {

@@ -29,6 +29,7 @@ pub mod ports;
 pub mod process;
 pub mod services;
 mod text;
+pub mod wire;
 
 pub use ports::{
     AdapterPorts, ClientPorts, DaemonLoopPorts, DaemonServicePorts, TruthPublisher, TruthSubscriber,
@@ -39,18 +40,21 @@ pub use config::{ConfigError, RuntimeConfig};
 pub use error::ShmError;
 pub use messages::{
     ClockMode, CommandMode, ControlCommand, ControlReply, ControlRequest, DaemonState,
-    DaemonStatus, HISTOGRAM_BUCKETS, JointCommand, LatencySummary, LinkState, LogHistogram,
-    SensorSample, SimTruth, SubmitReply, WRENCH_ORDER,
+    DaemonStatus, FAULT_TEXT, HISTOGRAM_BUCKETS, JointCommand, LatencySummary, LinkState,
+    LogHistogram, SensorSample, SimTruth, SubmitReply, WRENCH_ORDER,
 };
+pub use wire::{Code, DecodeError, Flag};
 
 pub use services::ServiceNames;
 pub use text::FixedText;
 
-/// Version of the wire protocol; part of every message's `#[type_name]`.
-pub const PROTOCOL_VERSION: u32 = 1;
+/// Version of the wire protocol; part of every message's `#[type_name]`. Version 2: enums and
+/// flags travel as checked integers ([`wire`]).
+pub const PROTOCOL_VERSION: u32 = 2;
 
 /// Fixed joint capacity of the joint arrays; messages carry the used count explicitly.
 pub const MAX_JOINTS: usize = 64;
 
-/// Largest post-processed sequence (JSON bytes) a client can submit.
+/// Default of `[runtime] max_submission_bytes`: the largest post-processed sequence (JSON
+/// bytes) walkd reads.
 pub const MAX_SEQUENCE_BYTES: usize = 16 * 1024 * 1024;

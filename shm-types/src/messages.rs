@@ -1,10 +1,14 @@
 //! The message types carried by the services (see the crate docs for who sends what).
 //!
 //! All are `#[repr(C)]`, `ZeroCopySend` and named `walk.v<PROTOCOL_VERSION>.<Type>` so a peer of
-//! another protocol version cannot open the same service by accident.
+//! another protocol version cannot open the same service by accident. None holds a Rust `enum`
+//! or `bool`: enums travel as [`Code`]s and flags as [`Flag`]s, so every bit pattern another
+//! process writes is a valid message, and the receiver decodes them with a check
+//! ([`crate::wire`]).
 
 use iceoryx2::prelude::ZeroCopySend;
 
+use crate::wire::{Code, DecodeError, Flag, wire_enum};
 use crate::{FixedText, MAX_JOINTS};
 
 /// Wrench order in [`SensorSample::wrenches`]: left foot, right foot, left hand, right hand.
@@ -13,7 +17,7 @@ pub const WRENCH_ORDER: [&str; 4] = ["left_foot", "right_foot", "left_hand", "ri
 /// One sensor reading, adapter → daemon.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v1.SensorSample")]
+#[type_name("walk.v2.SensorSample")]
 pub struct SensorSample {
     /// Strictly increasing per adapter run.
     pub seq: u64,
@@ -22,9 +26,9 @@ pub struct SensorSample {
     /// Used entries of `q` and `qd`, in the model's joint order.
     pub joint_count: u32,
     /// Whether `imu_orientation` holds a reading.
-    pub has_imu: bool,
+    pub has_imu: Flag,
     /// Whether the adapter currently holds position on its own (its command watchdog tripped).
-    pub adapter_holding: bool,
+    pub adapter_holding: Flag,
     /// Joint angles (rad or m).
     pub q: [f64; MAX_JOINTS],
     /// Joint velocities.
@@ -36,21 +40,20 @@ pub struct SensorSample {
     pub imu_orientation: [f64; 4],
 }
 
-/// What the adapter shall do with a [`JointCommand`].
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
-#[type_name("walk.v1.CommandMode")]
-pub enum CommandMode {
-    /// Keep the posture in `q_des` (velocities are zero).
-    Hold,
-    /// Track `q_des` / `qd_des`.
-    Track,
+wire_enum! {
+    /// What the adapter shall do with a [`JointCommand`].
+    pub enum CommandMode {
+        /// Keep the posture in `q_des` (velocities are zero).
+        Hold = 0 => "hold",
+        /// Track `q_des` / `qd_des`.
+        Track = 1 => "track",
+    }
 }
 
 /// One joint command, daemon → adapter.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v1.JointCommand")]
+#[type_name("walk.v2.JointCommand")]
 pub struct JointCommand {
     /// Strictly increasing per daemon run.
     pub seq: u64,
@@ -61,7 +64,7 @@ pub struct JointCommand {
     /// Used entries of `q_des` and `qd_des`.
     pub joint_count: u32,
     /// Hold or track.
-    pub mode: CommandMode,
+    pub mode: Code<CommandMode>,
     /// Desired joint positions.
     pub q_des: [f64; MAX_JOINTS],
     /// Desired joint velocities.
@@ -74,8 +77,8 @@ impl SensorSample {
         seq: 0,
         timestamp_ns: 0,
         joint_count: 0,
-        has_imu: false,
-        adapter_holding: false,
+        has_imu: Flag::NO,
+        adapter_holding: Flag::NO,
         q: [0.0; MAX_JOINTS],
         qd: [0.0; MAX_JOINTS],
         wrenches: [[0.0; 6]; 4],
@@ -90,6 +93,19 @@ impl SensorSample {
     /// The used joint velocities.
     pub fn qd(&self) -> &[f64] {
         &self.qd[..joint_len(self.joint_count)]
+    }
+
+    /// The IMU orientation (x, y, z, w) if the sample has one, or why `has_imu` is unreadable.
+    pub fn imu(&self) -> Result<Option<[f64; 4]>, DecodeError> {
+        let has_imu = self.has_imu.get().map_err(|e| e.in_field("has_imu"))?;
+        Ok(has_imu.then_some(self.imu_orientation))
+    }
+
+    /// Whether the adapter holds on its own, or why `adapter_holding` is unreadable.
+    pub fn holding(&self) -> Result<bool, DecodeError> {
+        self.adapter_holding
+            .get()
+            .map_err(|e| e.in_field("adapter_holding"))
     }
 }
 
@@ -106,7 +122,7 @@ impl JointCommand {
         answers_seq: 0,
         timestamp_ns: 0,
         joint_count: 0,
-        mode: CommandMode::Hold,
+        mode: Code::from_raw(0),
         q_des: [0.0; MAX_JOINTS],
         qd_des: [0.0; MAX_JOINTS],
     };
@@ -133,57 +149,31 @@ fn joint_len(count: u32) -> usize {
     (count as usize).min(MAX_JOINTS)
 }
 
-/// The daemon's state as clients see it.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
-#[type_name("walk.v1.DaemonState")]
-pub enum DaemonState {
-    /// Up, no sequence run yet.
-    Idle,
-    /// Holding the current posture (after hold, abort, a watchdog trip or a finished hold).
-    Holding,
-    /// Executing a sequence.
-    Executing,
-    /// The last sequence completed.
-    Done,
-    /// The controller faulted; `DaemonStatus::fault` says why.
-    Fault,
-    /// Shutting down (the last status before the daemon exits).
-    Stopping,
-}
-
-impl DaemonState {
-    /// Lower-case name for printing and JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Idle => "idle",
-            Self::Holding => "holding",
-            Self::Executing => "executing",
-            Self::Done => "done",
-            Self::Fault => "fault",
-            Self::Stopping => "stopping",
-        }
+wire_enum! {
+    /// The daemon's state as clients see it.
+    pub enum DaemonState {
+        /// Up, no sequence run yet.
+        Idle = 0 => "idle",
+        /// Holding the current posture (after hold, abort, a watchdog trip or a finished hold).
+        Holding = 1 => "holding",
+        /// Executing a sequence.
+        Executing = 2 => "executing",
+        /// The last sequence completed.
+        Done = 3 => "done",
+        /// The controller faulted; `DaemonStatus::fault` says why.
+        Fault = 4 => "fault",
+        /// Shutting down (the last status before the daemon exits).
+        Stopping = 5 => "stopping",
     }
 }
 
-/// How the daemon's control loop is clocked.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
-#[type_name("walk.v1.ClockMode")]
-pub enum ClockMode {
-    /// Fixed rate on absolute deadlines of `CLOCK_MONOTONIC`.
-    Realtime,
-    /// One tick per received sample; the simulator drives time.
-    Lockstep,
-}
-
-impl ClockMode {
-    /// Lower-case name, as accepted by `--clock`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Realtime => "realtime",
-            Self::Lockstep => "lockstep",
-        }
+wire_enum! {
+    /// How the daemon's control loop is clocked.
+    pub enum ClockMode {
+        /// Fixed rate on absolute deadlines of `CLOCK_MONOTONIC`.
+        Realtime = 0 => "realtime",
+        /// One tick per received sample; the simulator drives time.
+        Lockstep = 1 => "lockstep",
     }
 }
 
@@ -202,34 +192,22 @@ impl core::str::FromStr for ClockMode {
     }
 }
 
-/// Health of the link to the adapter as the daemon's watchdog sees it.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
-#[type_name("walk.v1.LinkState")]
-pub enum LinkState {
-    /// No sample received yet.
-    Waiting,
-    /// Samples arrive in time.
-    Fresh,
-    /// The watchdog tripped: no fresh sample for the configured number of periods.
-    Stale,
-}
-
-impl LinkState {
-    /// Lower-case name for printing and JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Waiting => "waiting",
-            Self::Fresh => "fresh",
-            Self::Stale => "stale",
-        }
+wire_enum! {
+    /// Health of the link to the adapter as the daemon's watchdog sees it.
+    pub enum LinkState {
+        /// No sample received yet.
+        Waiting = 0 => "waiting",
+        /// Samples arrive in time.
+        Fresh = 1 => "fresh",
+        /// The watchdog tripped: no fresh sample for the configured number of periods.
+        Stale = 2 => "stale",
     }
 }
 
 /// Percentiles of a latency distribution in microseconds.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("walk.v1.LatencySummary")]
+#[type_name("walk.v2.LatencySummary")]
 pub struct LatencySummary {
     /// Median.
     pub p50: f32,
@@ -246,7 +224,7 @@ pub const HISTOGRAM_BUCKETS: usize = 20;
 /// [2^b, 2^(b+1)) µs, the last bucket everything above.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("walk.v1.LogHistogram")]
+#[type_name("walk.v2.LogHistogram")]
 pub struct LogHistogram {
     /// Samples per bucket.
     pub counts: [u64; HISTOGRAM_BUCKETS],
@@ -262,7 +240,7 @@ impl LogHistogram {
 /// The daemon's state, published at a low rate (daemon → clients) and returned by `control`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v1.DaemonStatus")]
+#[type_name("walk.v2.DaemonStatus")]
 pub struct DaemonStatus {
     /// [`crate::PROTOCOL_VERSION`] of the daemon.
     pub protocol_version: u32,
@@ -271,9 +249,9 @@ pub struct DaemonStatus {
     /// When this status was assembled, [`crate::monotonic_ns`].
     pub timestamp_ns: u64,
     /// Controller state.
-    pub state: DaemonState,
+    pub state: Code<DaemonState>,
     /// Clock mode of the control loop.
-    pub clock: ClockMode,
+    pub clock: Code<ClockMode>,
     /// Control rate.
     pub rate_hz: f64,
     /// Id of the sequence executing or last executed (0: none yet).
@@ -290,12 +268,12 @@ pub struct DaemonStatus {
     pub left_foot: [f64; 7],
     /// Right sole pose: translation xyz + quaternion xyzw.
     pub right_foot: [f64; 7],
-    /// Last fault (empty: none).
-    pub fault: FixedText<160>,
+    /// The fault not yet acknowledged: its first cause, then what followed from it (empty: none).
+    pub fault: FixedText<FAULT_TEXT>,
     /// Adapter link as seen by the watchdog.
-    pub link: LinkState,
+    pub link: Code<LinkState>,
     /// Whether the adapter reports holding on its own.
-    pub adapter_holding: bool,
+    pub adapter_holding: Flag,
     /// Control ticks executed.
     pub ticks: u64,
     /// Periods whose command went out after the period's deadline (realtime clock only).
@@ -304,6 +282,10 @@ pub struct DaemonStatus {
     pub stale_periods: u64,
     /// Times the sample watchdog tripped.
     pub watchdog_trips: u64,
+    /// Samples refused for their time stamp (in the future, or older than the last one).
+    pub rejected_samples: u64,
+    /// Why the last sample was refused (empty: none yet).
+    pub last_rejection: FixedText<96>,
     /// Compute time of `Controller::tick`.
     pub tick_us: LatencySummary,
     /// Sample timestamp → command sent.
@@ -324,8 +306,8 @@ impl DaemonStatus {
         protocol_version: crate::PROTOCOL_VERSION,
         pid: 0,
         timestamp_ns: 0,
-        state: DaemonState::Idle,
-        clock: ClockMode::Realtime,
+        state: Code::from_raw(0),
+        clock: Code::from_raw(0),
         rate_hz: 0.0,
         sequence_id: 0,
         stance_index: 0,
@@ -335,12 +317,14 @@ impl DaemonStatus {
         left_foot: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
         right_foot: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
         fault: FixedText::EMPTY,
-        link: LinkState::Waiting,
-        adapter_holding: false,
+        link: Code::from_raw(0),
+        adapter_holding: Flag::NO,
         ticks: 0,
         deadline_misses: 0,
         stale_periods: 0,
         watchdog_trips: 0,
+        rejected_samples: 0,
+        last_rejection: FixedText::EMPTY,
         tick_us: LatencySummary {
             p50: 0.0,
             p99: 0.0,
@@ -368,11 +352,27 @@ impl DaemonStatus {
     };
 }
 
+impl DaemonStatus {
+    /// Checks the fields a client decodes (state, clock, link, flags); names the first bad one.
+    pub fn validate(&self) -> Result<(), DecodeError> {
+        self.state.get().map_err(|e| e.in_field("state"))?;
+        self.clock.get().map_err(|e| e.in_field("clock"))?;
+        self.link.get().map_err(|e| e.in_field("link"))?;
+        self.adapter_holding
+            .get()
+            .map_err(|e| e.in_field("adapter_holding"))?;
+        Ok(())
+    }
+}
+
 impl Default for DaemonStatus {
     fn default() -> Self {
         Self::INITIAL
     }
 }
+
+/// Capacity of [`DaemonStatus::fault`] (bytes): a first cause and the effects that followed.
+pub const FAULT_TEXT: usize = 256;
 
 /// The simulated robot's true state, simulator → evaluation clients (`sim-truth` service).
 ///
@@ -382,7 +382,7 @@ impl Default for DaemonStatus {
 /// [`DaemonStatus`] (world frame, translation xyz + quaternion xyzw of the sole frames).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("walk.v1.SimTruth")]
+#[type_name("walk.v2.SimTruth")]
 pub struct SimTruth {
     /// Strictly increasing per simulator run (a gap means a subscriber missed messages).
     pub seq: u64,
@@ -402,7 +402,7 @@ pub struct SimTruth {
     /// Angle between the `base_link` z axis and the world vertical (rad).
     pub tilt_rad: f64,
     /// Whether the simulator's fall rule fired at any time since the start (it stays set).
-    pub fallen: bool,
+    pub fallen: Flag,
 }
 
 impl SimTruth {
@@ -416,7 +416,7 @@ impl SimTruth {
         right_foot: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
         base_height_m: 0.0,
         tilt_rad: 0.0,
-        fallen: false,
+        fallen: Flag::NO,
     };
 }
 
@@ -429,10 +429,10 @@ impl Default for SimTruth {
 /// The daemon's answer to a submitted sequence.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v1.SubmitReply")]
+#[type_name("walk.v2.SubmitReply")]
 pub struct SubmitReply {
     /// Whether the sequence was validated, prepared and started.
-    pub accepted: bool,
+    pub accepted: Flag,
     /// Id given to an accepted sequence (0 when refused).
     pub sequence_id: u64,
     /// Why it was refused (empty when accepted).
@@ -443,7 +443,7 @@ impl SubmitReply {
     /// An acceptance with the sequence's id.
     pub fn accepted(sequence_id: u64) -> Self {
         Self {
-            accepted: true,
+            accepted: Flag::YES,
             sequence_id,
             reason: FixedText::EMPTY,
         }
@@ -452,7 +452,7 @@ impl SubmitReply {
     /// A refusal with its reason.
     pub fn refused(reason: &str) -> Self {
         Self {
-            accepted: false,
+            accepted: Flag::NO,
             sequence_id: 0,
             reason: FixedText::new(reason),
         }
@@ -465,54 +465,49 @@ impl Default for SubmitReply {
     }
 }
 
-/// What a client asks of the daemon on the `control` service.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
-#[type_name("walk.v1.ControlCommand")]
-pub enum ControlCommand {
-    /// Only return the current status.
-    Query,
-    /// Stop where it is and hold the current posture.
-    Hold,
-    /// Abort the executing sequence and hold safely.
-    Abort,
-}
-
-impl ControlCommand {
-    /// Lower-case name for printing.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Query => "query",
-            Self::Hold => "hold",
-            Self::Abort => "abort",
-        }
+wire_enum! {
+    /// What a client asks of the daemon on the `control` service.
+    pub enum ControlCommand {
+        /// Only return the current status.
+        Query = 0 => "query",
+        /// Stop where it is and hold the current posture (acknowledges a fault).
+        Hold = 1 => "hold",
+        /// Abort the executing sequence and hold safely (acknowledges a fault).
+        Abort = 2 => "abort",
     }
 }
 
 /// A control request (client → daemon).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v1.ControlRequest")]
+#[type_name("walk.v2.ControlRequest")]
 pub struct ControlRequest {
     /// The command.
-    pub command: ControlCommand,
+    pub command: Code<ControlCommand>,
+}
+
+impl ControlRequest {
+    /// A request for `command`.
+    pub fn new(command: ControlCommand) -> Self {
+        Self {
+            command: Code::new(command),
+        }
+    }
 }
 
 impl Default for ControlRequest {
     fn default() -> Self {
-        Self {
-            command: ControlCommand::Query,
-        }
+        Self::new(ControlCommand::Query)
     }
 }
 
 /// The daemon's answer to a control request.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
-#[type_name("walk.v1.ControlReply")]
+#[type_name("walk.v2.ControlReply")]
 pub struct ControlReply {
     /// Whether the command was carried out.
-    pub accepted: bool,
+    pub accepted: Flag,
     /// A short explanation (why refused, or what happened).
     pub message: FixedText<160>,
     /// The status right after handling the command.
@@ -533,19 +528,16 @@ mod tests {
             [
                 SensorSample::type_name(),
                 JointCommand::type_name(),
-                CommandMode::type_name(),
                 DaemonStatus::type_name(),
-                DaemonState::type_name(),
-                ClockMode::type_name(),
-                LinkState::type_name(),
                 LatencySummary::type_name(),
                 LogHistogram::type_name(),
                 SubmitReply::type_name(),
                 ControlRequest::type_name(),
-                ControlCommand::type_name(),
                 ControlReply::type_name(),
                 SimTruth::type_name(),
                 FixedText::<8>::type_name(),
+                Flag::type_name(),
+                Code::<CommandMode>::type_name(),
             ]
         };
         for name in names {

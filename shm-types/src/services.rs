@@ -26,6 +26,28 @@ pub struct ServiceNames {
     prefix: String,
 }
 
+/// Port limits of every service (iceoryx2 fixes them when a service is created). iceoryx2 has no
+/// per-process quota, so each limit leaves room beyond the ports the system itself uses: a
+/// process that holds a few ports (a leak, a greedy monitor, a second adapter started by
+/// mistake) cannot lock out the daemon, its adapter or monitoring. docs/ipc.md ("Capacity")
+/// lists them.
+pub mod capacity {
+    /// Publishers on `sensors` (the adapter; an adapter restarting while the dead one is
+    /// cleaned; spare) and on `commands` (walkd; a restarting walkd; spare). walkd refuses to
+    /// walk while `sensors` has more than one (see `DaemonLoopPorts::sensor_publishers`).
+    pub const STREAM_PUBLISHERS: usize = 4;
+    /// Subscribers of `sensors` and `commands`: walkd or the adapter, plus observers.
+    pub const STREAM_SUBSCRIBERS: usize = 16;
+    /// Subscribers of `status`: every `walkctl watch`, `status`, `demo` and observer.
+    pub const STATUS_SUBSCRIBERS: usize = 64;
+    /// Clients of `control` (query, hold, abort).
+    pub const CONTROL_CLIENTS: usize = 32;
+    /// Clients of `stances` (each holds a data segment for its largest submission).
+    pub const STANCES_CLIENTS: usize = 16;
+    /// Processes' nodes that may open one service.
+    pub const NODES: usize = 128;
+}
+
 /// The service kinds, used to build names.
 const SENSORS: &str = "sensors";
 const COMMANDS: &str = "commands";
@@ -197,8 +219,9 @@ pub(crate) fn stream<T: StreamPayload>(
         .history_size(1)
         .subscriber_max_buffer_size(4)
         .subscriber_max_borrowed_samples(4)
-        .max_publishers(2)
-        .max_subscribers(8)
+        .max_publishers(capacity::STREAM_PUBLISHERS)
+        .max_subscribers(capacity::STREAM_SUBSCRIBERS)
+        .max_nodes(capacity::NODES)
         .open_or_create()
         .map_err(|e| pubsub_error(&service, e))
 }
@@ -211,8 +234,9 @@ pub(crate) fn stream_event<T: StreamPayload>(
     let service = names.full(T::KIND);
     node.service_builder(&names.service_name(T::KIND)?)
         .event()
-        .max_notifiers(4)
-        .max_listeners(8)
+        .max_notifiers(capacity::STREAM_PUBLISHERS)
+        .max_listeners(capacity::STREAM_SUBSCRIBERS)
+        .max_nodes(capacity::NODES)
         .open_or_create()
         .map_err(|e: EventOpenOrCreateError| ShmError::ipc("open or create event", &service, e))
 }
@@ -231,7 +255,8 @@ pub(crate) fn status(
         .subscriber_max_buffer_size(2)
         .subscriber_max_borrowed_samples(2)
         .max_publishers(2)
-        .max_subscribers(16);
+        .max_subscribers(capacity::STATUS_SUBSCRIBERS)
+        .max_nodes(capacity::NODES);
     match access {
         Access::OpenOrCreate => builder
             .open_or_create()
@@ -258,7 +283,8 @@ pub(crate) fn sim_truth(
         .subscriber_max_buffer_size(SIM_TRUTH_BUFFER)
         .subscriber_max_borrowed_samples(2)
         .max_publishers(2)
-        .max_subscribers(4)
+        .max_subscribers(capacity::STREAM_SUBSCRIBERS)
+        .max_nodes(capacity::NODES)
         .open_or_create()
         .map_err(|e| pubsub_error(&service, e))
 }
@@ -266,12 +292,13 @@ pub(crate) fn sim_truth(
 /// Opens a client → daemon request-response service: few clients, one answer per request.
 /// (A macro because iceoryx2's builder has distinct impls for sized and slice requests.)
 macro_rules! request_response_service {
-    ($node:expr, $names:expr, $kind:expr, $access:expr, $req:ty, $resp:ty) => {{
+    ($node:expr, $names:expr, $kind:expr, $access:expr, $clients:expr, $req:ty, $resp:ty) => {{
         let service = $names.full($kind);
         let builder = $node
             .service_builder(&$names.service_name($kind)?)
             .request_response::<$req, $resp>()
-            .max_clients(8)
+            .max_clients($clients)
+            .max_nodes(capacity::NODES)
             .max_servers(2)
             .max_active_requests_per_client(2)
             .max_response_buffer_size(2);
@@ -291,7 +318,15 @@ pub(crate) fn stances(
     names: &ServiceNames,
     access: Access,
 ) -> Result<SubmitService, ShmError> {
-    request_response_service!(node, names, STANCES, access, [u8], SubmitReply)
+    request_response_service!(
+        node,
+        names,
+        STANCES,
+        access,
+        capacity::STANCES_CLIENTS,
+        [u8],
+        SubmitReply
+    )
 }
 
 pub(crate) fn control(
@@ -299,7 +334,15 @@ pub(crate) fn control(
     names: &ServiceNames,
     access: Access,
 ) -> Result<ControlService, ShmError> {
-    request_response_service!(node, names, CONTROL, access, ControlRequest, ControlReply)
+    request_response_service!(
+        node,
+        names,
+        CONTROL,
+        access,
+        capacity::CONTROL_CLIENTS,
+        ControlRequest,
+        ControlReply
+    )
 }
 
 /// Converts an absolute time on [`crate::monotonic_ns`] into the timeout left until then.

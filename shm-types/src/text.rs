@@ -6,7 +6,7 @@ use iceoryx2::prelude::ZeroCopySend;
 /// Longer input is cut at a character boundary.
 #[repr(C)]
 #[derive(Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v1.FixedText")]
+#[type_name("walk.v2.FixedText")]
 pub struct FixedText<const N: usize> {
     len: u32,
     bytes: [u8; N],
@@ -48,6 +48,28 @@ impl<const N: usize> FixedText<N> {
     }
 }
 
+/// Appends, cutting at the capacity (never fails, never allocates), so a message can be
+/// composed with `write!` on the real-time path.
+impl<const N: usize> core::fmt::Write for FixedText<N> {
+    fn write_str(&mut self, text: &str) -> core::fmt::Result {
+        let len = (self.len as usize).min(N);
+        let mut end = text.len().min(N - len);
+        while !text.is_char_boundary(end) {
+            end -= 1;
+        }
+        self.bytes[len..len + end].copy_from_slice(&text.as_bytes()[..end]);
+        self.len = (len + end) as u32;
+        Ok(())
+    }
+}
+
+impl<const N: usize> FixedText<N> {
+    /// Empties the text.
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+}
+
 impl<const N: usize> Default for FixedText<N> {
     fn default() -> Self {
         Self::EMPTY
@@ -76,5 +98,15 @@ mod tests {
         assert_eq!(text.as_str(), "abcd");
         assert_eq!(FixedText::<8>::new("hold").as_str(), "hold");
         assert!(FixedText::<8>::EMPTY.is_empty());
+    }
+
+    #[test]
+    fn write_appends_and_cuts_at_the_capacity() {
+        use core::fmt::Write;
+        let mut text = FixedText::<10>::new("ab");
+        write!(text, "-{}-", 123).unwrap();
+        assert_eq!(text.as_str(), "ab-123-");
+        write!(text, "éééé").unwrap();
+        assert_eq!(text.as_str(), "ab-123-é");
     }
 }

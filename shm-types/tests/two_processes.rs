@@ -79,7 +79,7 @@ fn daemon_and_adapter_exchange_samples_commands_and_requests() {
         }
         if services
             .serve_control(|command| ControlReply {
-                accepted: command == ControlCommand::Hold,
+                accepted: (command == Ok(ControlCommand::Hold)).into(),
                 status,
                 ..ControlReply::default()
             })
@@ -120,10 +120,10 @@ fn run_peer(prefix: &str) {
     let client = ClientPorts::connect(&names, "client").unwrap();
     assert!(client.daemon_present());
     let reply = client.submit(br#"{"stances":[]}"#, TIMEOUT).unwrap();
-    assert!(reply.accepted);
+    assert!(reply.accepted.is_set());
     assert_eq!(reply.sequence_id, 42);
     let reply = client.control(ControlCommand::Hold, TIMEOUT).unwrap();
-    assert!(reply.accepted);
+    assert!(reply.accepted.is_set());
     assert_eq!(reply.status.ticks, ROUNDS);
     assert_eq!(client.next_status(TIMEOUT).unwrap().ticks, ROUNDS);
 }

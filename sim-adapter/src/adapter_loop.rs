@@ -3,8 +3,8 @@
 use std::time::Duration;
 
 use shm_types::{
-    AdapterPorts, ClockMode, CommandMode, JointCommand, MAX_JOINTS, SensorSample, ShmError,
-    monotonic_ns, sleep_then_spin_until,
+    AdapterPorts, ClockMode, CommandMode, DecodeError, JointCommand, MAX_JOINTS, SensorSample,
+    ShmError, monotonic_ns, sleep_then_spin_until,
 };
 
 use crate::RobotIo;
@@ -41,6 +41,8 @@ pub struct AdapterReport {
     pub watchdog_trips: u64,
     /// Realtime periods skipped because the loop overran.
     pub overruns: u64,
+    /// Commands refused: an unknown mode, or a setpoint the robot rejected (NaN, wrong size).
+    pub refused_commands: u64,
 }
 
 /// Why the loop stopped early.
@@ -69,14 +71,46 @@ impl Setpoint {
         self.qd = [0.0; MAX_JOINTS];
     }
 
-    /// Follow `command` (a hold command keeps its posture with zero velocity).
-    fn follow(&mut self, command: &JointCommand) {
+    /// Follow `command` (a hold command keeps its posture with zero velocity); refuses a
+    /// command whose mode the contract does not define.
+    fn follow(&mut self, command: &JointCommand) -> Result<(), DecodeError> {
+        let mode = command.mode.get().map_err(|e| e.in_field("mode"))?;
         self.holding = false;
         self.q = command.q_des;
-        self.qd = match command.mode {
+        self.qd = match mode {
             CommandMode::Track => command.qd_des,
             CommandMode::Hold => [0.0; MAX_JOINTS],
         };
+        Ok(())
+    }
+}
+
+/// Logs a repeated problem once, then at most once per [`Throttle::INTERVAL_NS`] with the
+/// count since, so a daemon sending bad commands at 1 kHz cannot flood the log.
+struct Throttle {
+    suppressed: u64,
+    next_ns: u64,
+}
+
+impl Throttle {
+    const INTERVAL_NS: u64 = 1_000_000_000;
+
+    fn new() -> Self {
+        Self {
+            suppressed: 0,
+            next_ns: 0,
+        }
+    }
+
+    /// Whether to log now; `Some(n)`: log, saying `n` similar events were not logged.
+    fn due(&mut self) -> Option<u64> {
+        let now = monotonic_ns();
+        if now < self.next_ns {
+            self.suppressed += 1;
+            return None;
+        }
+        self.next_ns = now + Self::INTERVAL_NS;
+        Some(std::mem::take(&mut self.suppressed))
     }
 }
 
@@ -91,7 +125,7 @@ struct Adapter<'a, R: RobotIo> {
     command: JointCommand,
     setpoint: Setpoint,
     report: AdapterReport,
-    write_failed: bool,
+    refusals: Throttle,
 }
 
 impl<R: RobotIo> Adapter<'_, R> {
@@ -100,7 +134,7 @@ impl<R: RobotIo> Adapter<'_, R> {
         self.robot.read(&mut self.sample);
         self.sample.seq += 1;
         self.sample.joint_count = self.joints as u32;
-        self.sample.adapter_holding = self.setpoint.holding;
+        self.sample.adapter_holding = self.setpoint.holding.into();
         let sample = &self.sample;
         self.ports.publish_sample(|out| *out = *sample)?;
         self.report.samples += 1;
@@ -115,9 +149,13 @@ impl<R: RobotIo> Adapter<'_, R> {
             .robot
             .write(&self.setpoint.q[..n], &self.setpoint.qd[..n], self.dt)
         {
-            if !self.write_failed {
-                tracing::error!(%error, "setpoint rejected by the robot: holding position");
-                self.write_failed = true;
+            self.report.refused_commands += 1;
+            if let Some(suppressed) = self.refusals.due() {
+                tracing::error!(
+                    %error,
+                    since_last_report = suppressed,
+                    "setpoint rejected by the robot: holding position"
+                );
             }
             self.setpoint.hold(&self.sample);
             // The hold posture is the last reading, which the robot accepted before.
@@ -144,11 +182,23 @@ impl<R: RobotIo> Adapter<'_, R> {
         if must_answer_last && self.command.answers_seq != self.sample.seq {
             return Ok(false);
         }
-        if self.setpoint.holding && self.report.commands > 0 {
+        let was_holding = self.setpoint.holding;
+        if let Err(error) = self.setpoint.follow(&self.command) {
+            self.report.refused_commands += 1;
+            if let Some(suppressed) = self.refusals.due() {
+                tracing::error!(
+                    %error,
+                    command = self.command.seq,
+                    since_last_report = suppressed,
+                    "command refused: holding position"
+                );
+            }
+            self.setpoint.hold(&self.sample);
+            return Ok(false);
+        }
+        if was_holding && self.report.commands > 0 {
             tracing::info!("commands are fresh again: following the daemon");
         }
-        self.setpoint.follow(&self.command);
-        self.write_failed = false;
         self.report.commands += 1;
         Ok(true)
     }
@@ -230,7 +280,7 @@ pub fn run_adapter<R: RobotIo>(
             qd: [0.0; MAX_JOINTS],
         },
         report: AdapterReport::default(),
-        write_failed: false,
+        refusals: Throttle::new(),
     };
     adapter.robot.read(&mut adapter.sample);
     adapter.setpoint.hold(&adapter.sample);

@@ -67,6 +67,6 @@ impl GroundTruth for KinematicRobot {
             pose_array(&kinematics.frame_pose(&robot.model, robot.frame(EndEffector::RightFoot)));
         out.base_height_m = base_link.translation.z;
         out.tilt_rad = tilt(base_link);
-        out.fallen = self.sim.summary().fell;
+        out.fallen = self.sim.summary().fell.into();
     }
 }

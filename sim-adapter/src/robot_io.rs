@@ -36,5 +36,5 @@ pub(crate) fn fill_sample(measurement: &SimMeasurement, sample: &mut SensorSampl
     sample.wrenches = measurement.wrenches;
     let q = measurement.base_orientation.quaternion();
     sample.imu_orientation = [q.i, q.j, q.k, q.w];
-    sample.has_imu = true;
+    sample.has_imu = true.into();
 }

@@ -77,7 +77,7 @@ fn answer(daemon: &DaemonLoopPorts, sample: &SensorSample, q0: f64) {
         .send_command(|command| {
             command.answers_seq = sample.seq;
             command.joint_count = 3;
-            command.mode = CommandMode::Track;
+            command.mode = CommandMode::Track.into();
             command.q_des[..3].copy_from_slice(&[q0, 0.0, 0.0]);
         })
         .unwrap();
@@ -90,39 +90,42 @@ fn check(clock: ClockMode, test: &str) {
     let mut sample = SensorSample::ZERO;
 
     next_sample(&daemon, &mut sample);
-    assert!(sample.adapter_holding, "holds until the first command");
+    assert!(
+        sample.adapter_holding.is_set(),
+        "holds until the first command"
+    );
     assert_eq!(sample.q(), &[0.1, 0.2, 0.3]);
     for i in 1..=20 {
         answer(&daemon, &sample, i as f64);
         next_sample(&daemon, &mut sample);
     }
     // The last samples reflect the commands.
-    assert!(!sample.adapter_holding);
+    assert!(!sample.adapter_holding.is_set());
     assert!(sample.q[0] >= 19.0, "{:?}", sample.q());
 
     // Stop answering: the adapter holds the last posture.
     let mut held = None;
     for _ in 0..200 {
         next_sample(&daemon, &mut sample);
-        if sample.adapter_holding {
+        if sample.adapter_holding.is_set() {
             held = Some(sample);
             break;
         }
     }
     let held = held.expect("the adapter never held");
     next_sample(&daemon, &mut sample);
-    assert!(sample.adapter_holding);
+    assert!(sample.adapter_holding.is_set());
     assert_eq!(sample.q(), held.q(), "the hold posture moved");
 
     // Answer again: it follows.
     answer(&daemon, &sample, 42.0);
     for _ in 0..20 {
         next_sample(&daemon, &mut sample);
-        if !sample.adapter_holding {
+        if !sample.adapter_holding.is_set() {
             break;
         }
     }
-    assert!(!sample.adapter_holding);
+    assert!(!sample.adapter_holding.is_set());
     assert_eq!(sample.q[0], 42.0);
 
     stop.store(true, Ordering::Relaxed);

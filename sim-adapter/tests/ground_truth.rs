@@ -34,7 +34,7 @@ fn assert_standing(name: &str, truth: &SimTruth) {
         truth.base_height_m
     );
     assert!(truth.com[2] > 0.5, "{name}: CoM {:?}", truth.com);
-    assert!(!truth.fallen, "{name}");
+    assert!(!truth.fallen.is_set(), "{name}");
 }
 
 #[test]

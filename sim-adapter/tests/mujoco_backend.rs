@@ -511,7 +511,7 @@ fn the_adapter_side_reads_what_the_simulator_measures() {
     assert_eq!(&sample.q[..n], m.q.as_slice());
     assert_eq!(&sample.qd[..n], m.qd.as_slice());
     assert_eq!(sample.wrenches, m.wrenches);
-    assert!(sample.has_imu);
+    assert!(sample.has_imu.is_set());
     let orientation = m.base_orientation.quaternion();
     assert_eq!(
         sample.imu_orientation,

@@ -83,8 +83,8 @@ pub enum FormatError {
         found: &'static str,
     },
     /// The file names another robot than the one it is loaded for.
-    #[error("field `robot`: unknown robot `{found}`; the loaded robot is `{expected}`")]
-    UnknownRobot { found: String, expected: String },
+    #[error("the sequence is for robot `{found}`, not for `{expected}` (field `robot`)")]
+    RobotMismatch { found: String, expected: String },
     /// `joint_names` has another length than the robot's joint list.
     #[error("field `joint_names`: {found} joints listed, the robot `{robot}` has {expected}")]
     JointNameCount {

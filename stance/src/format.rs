@@ -237,6 +237,39 @@ fn is_non_finite_literal(token: &str) -> bool {
 }
 
 /// Maps a serde_json error to a located [`FormatError`].
+/// The number of stances in a stance file, counted without building them: a reader can bound a
+/// submission before it parses it (the pass skips every value and allocates nothing per stance).
+pub fn count_stances(text: &str) -> Result<usize, FormatError> {
+    #[derive(Deserialize)]
+    struct Count {
+        #[serde(deserialize_with = "count_elements")]
+        stances: usize,
+    }
+    fn count_elements<'de, D: serde::Deserializer<'de>>(d: D) -> Result<usize, D::Error> {
+        struct Counter;
+        impl<'de> serde::de::Visitor<'de> for Counter {
+            type Value = usize;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an array of stances")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<usize, A::Error> {
+                let mut count = 0;
+                while seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+                    count += 1;
+                }
+                Ok(count)
+            }
+        }
+        d.deserialize_seq(Counter)
+    }
+    serde_json::from_str::<Count>(text)
+        .map(|count| count.stances)
+        .map_err(|error| json_error(text, error))
+}
+
 fn json_error(text: &str, error: serde_json::Error) -> FormatError {
     let (line, column) = (error.line(), error.column());
     let offset = offset_of(text, line, column);

@@ -2,6 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
+use kinematics::ConfigFile;
+use kinematics::ConfigFileError;
 use serde::Deserialize;
 
 /// How a run of contacts of one end-effector is made static (pass 2).
@@ -45,18 +47,9 @@ pub struct PostProcessParams {
 /// Why the `[postprocess]` section could not be used.
 #[derive(Debug, thiserror::Error)]
 pub enum ParamsError {
-    /// The config file could not be read.
-    #[error("{path}: cannot read: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    /// The config file is not TOML.
-    #[error("{path}: invalid TOML: {source}")]
-    Toml {
-        path: PathBuf,
-        source: toml::de::Error,
-    },
+    /// The config file could not be read or parsed.
+    #[error(transparent)]
+    File(#[from] ConfigFileError),
     /// No `[postprocess]` table.
     #[error("{path}: missing section [postprocess]")]
     MissingSection { path: PathBuf },
@@ -75,21 +68,19 @@ pub enum ParamsError {
 impl PostProcessParams {
     /// Reads the `[postprocess]` section of the robot config at `path`.
     pub fn from_config_path(path: &Path) -> Result<Self, ParamsError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ParamsError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-        Self::from_config_str(&text, path)
+        Self::from_config(&ConfigFile::load(path)?)
     }
 
     /// Reads the `[postprocess]` section of a robot config's text (`path` names it in errors).
     pub fn from_config_str(text: &str, path: &Path) -> Result<Self, ParamsError> {
-        let table: toml::Table = toml::from_str(text).map_err(|source| ParamsError::Toml {
-            path: path.to_owned(),
-            source,
-        })?;
-        let section = table
-            .get("postprocess")
+        Self::from_config(&ConfigFile::parse(text, path)?)
+    }
+
+    /// Reads the `[postprocess]` section of a loaded robot config.
+    pub fn from_config(file: &ConfigFile) -> Result<Self, ParamsError> {
+        let path = file.path();
+        let section = file
+            .section("postprocess")
             .ok_or_else(|| ParamsError::MissingSection {
                 path: path.to_owned(),
             })?
@@ -100,7 +91,7 @@ impl PostProcessParams {
                 path: path.to_owned(),
                 message: e.message().to_owned(),
             })?;
-        params.validate(&path.display().to_string())?;
+        params.validate(&file.origin())?;
         Ok(params)
     }
 

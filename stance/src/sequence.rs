@@ -218,7 +218,7 @@ const QUATERNION_TOLERANCE: f64 = 1e-6;
 
 fn check_robot(name: &str, joint_names: &[String], robot: &Robot) -> Result<(), FormatError> {
     if name != robot.name {
-        return Err(FormatError::UnknownRobot {
+        return Err(FormatError::RobotMismatch {
             found: name.to_owned(),
             expected: robot.name.clone(),
         });

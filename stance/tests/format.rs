@@ -158,7 +158,7 @@ fn unknown_robot_is_refused() {
     let err = read_edited(|v| v["robot"] = json!("hrp5")).unwrap_err();
     assert_eq!(
         err.to_string(),
-        "field `robot`: unknown robot `hrp5`; the loaded robot is `jvrc1`"
+        "the sequence is for robot `hrp5`, not for `jvrc1` (field `robot`)"
     );
 }
 

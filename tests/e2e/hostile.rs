@@ -9,7 +9,8 @@ use std::time::{Duration, Instant};
 use kinematics::robot::Robot;
 use shm_types::{DaemonState, LinkState, SensorSample};
 use walk_tests::hostile::{
-    Feeder, PortHog, Raw, RawAdapter, RawClient, command_answers, command_q, standing_sample,
+    Feeder, PortHog, Raw, RawAdapter, RawClient, RawDaemon, command_answers, command_q,
+    standing_sample,
 };
 use walk_tests::{
     config, connect_when_fresh, start_sim, start_walkd, unique_prefix, wait_for_status, wait_until,
@@ -131,23 +132,39 @@ fn a_sample_stamped_in_the_future_does_not_freeze_the_control_thread() {
 }
 
 /// Item 3: joints measured outside their limits are a fault naming the joint; no walk starts,
-/// and no command, hold included, leaves the limits.
+/// and no command, hold included, leaves the limits. Before any valid measurement there is no
+/// safe posture at all and walkd commands nothing (the adapter holds on its own).
 #[test]
 fn joints_measured_outside_their_limits_fault_and_commands_stay_inside() {
     let prefix = unique_prefix("hostile_limits");
     let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
     let robot = robot("armar4");
+    let dof = robot.model.dof();
     let mut adapter = RawAdapter::open_when_ready(&prefix, START).unwrap();
     let mut broken = standing_sample(&robot);
-    broken.q[..robot.model.dof()].fill(100.0);
+    broken.q[..dof].fill(100.0);
     let commands = adapter.stream(&broken, PERIOD, Duration::from_millis(300));
-    assert!(!commands.is_empty(), "{}", walkd.log());
-    assert_within_limits(&robot, &commands);
+    assert!(
+        commands.is_empty(),
+        "commands before a valid measurement\n{}",
+        walkd.log()
+    );
     let client = walk_tests::connect(&prefix).unwrap();
     let status = client.status().unwrap();
     assert_eq!(status.state, DaemonState::Fault, "{status:?}");
     let first = &robot.model.joint_names()[0];
     assert!(status.fault.as_str().contains(first.as_str()), "{status:?}");
+
+    // Valid, then broken again: hold keeps the last command, inside the limits.
+    let standing = standing_sample(&robot);
+    let valid = adapter.stream(&standing, PERIOD, Duration::from_millis(200));
+    assert!(!valid.is_empty(), "{}", walkd.log());
+    client.control(shm_types::ControlCommand::Hold).unwrap();
+    let held = adapter.stream(&broken, PERIOD, Duration::from_millis(300));
+    assert!(!held.is_empty(), "{}", walkd.log());
+    assert_within_limits(&robot, &held);
+    let last_valid = command_q(valid.last().unwrap(), dof);
+    assert!(held.iter().all(|c| command_q(c, dof) == last_valid));
 
     // A walk cannot start, and while samples keep coming nothing leaves the limits.
     drop(adapter);
@@ -412,8 +429,13 @@ fn a_greedy_process_cannot_lock_out_monitoring_or_the_adapter() {
         walk_tests::connect(&prefix).ok()
     })
     .unwrap();
-    let hog = PortHog::take(&prefix, 8).unwrap();
-    assert_eq!(hog.taken.0, 8, "{:?}", hog.taken);
+    // As many control clients and status subscribers as the services had before they were
+    // sized for this, and a second publisher on sensors.
+    let hog = wait_until("walkd's services", START, || {
+        PortHog::take(&prefix, 8, 1).ok()
+    })
+    .unwrap();
+    assert_eq!(hog.taken, (8, 8, 1), "{:?}", hog.taken);
     let _sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
     let status = walk_tests::run_walkctl(&["status", "--service-prefix", &prefix])
         .unwrap_or_else(|e| panic!("walkctl status: {e}\n{}", walkd.log()));
@@ -426,4 +448,52 @@ fn a_greedy_process_cannot_lock_out_monitoring_or_the_adapter() {
     let client = walk_tests::connect(&prefix).unwrap();
     let status = client.status().unwrap();
     assert!(status.fault.as_str().contains("publishers"), "{status:?}");
+}
+
+/// Item 9, the smaller defects: a refused submission uses up no sequence id; walkctl says at
+/// once that no walkd runs; an adapter sent a flood of bad commands logs a few lines, not one
+/// per command.
+#[test]
+fn refusals_use_no_id_a_dead_walkd_is_named_at_once_and_bad_commands_do_not_flood_the_log() {
+    let prefix = unique_prefix("hostile_small");
+    let mut walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    let sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
+    let client = connect_when_fresh(&prefix, START).unwrap();
+    let (json, _) = walk_json("armar4", 0.3).unwrap();
+    assert!(client.submit_json("{ not json").is_err());
+    assert_eq!(
+        client.submit_json(&json).unwrap(),
+        1,
+        "a refusal used up an id"
+    );
+    drop(client);
+    walkd.signal(libc::SIGKILL);
+    walkd.wait_exit(Duration::from_secs(5)).unwrap();
+    let started = Instant::now();
+    let error = walk_tests::run_walkctl(&["status", "--service-prefix", &prefix]).unwrap_err();
+    assert!(error.to_string().contains("no walkd serves"), "{error}");
+    assert!(
+        started.elapsed() < Duration::from_secs(3),
+        "{:?}",
+        started.elapsed()
+    );
+
+    let mut daemon = RawDaemon::open(&prefix).unwrap();
+    let robot = robot("armar4");
+    let mut command = shm_types::JointCommand::ZERO;
+    command.joint_count = robot.model.dof() as u32;
+    command.q_des[..robot.model.dof()].copy_from_slice(robot.standing.joints.as_slice());
+    for _ in 0..500 {
+        daemon.publish(&command, |raw| {
+            raw.put(offset_of!(shm_types::JointCommand, mode), 257u32)
+        });
+        std::thread::sleep(PERIOD);
+    }
+    let log = sim.log();
+    let refusals = log.matches("command refused").count();
+    assert!(
+        (1..=3).contains(&refusals),
+        "{refusals} log lines for 500 bad commands\n{log}"
+    );
+    assert!(log.contains("mode holds 257"), "{log}");
 }

@@ -315,6 +315,58 @@ impl Drop for Feeder {
     }
 }
 
+/// A daemon that publishes raw joint commands to an adapter.
+pub struct RawDaemon {
+    publisher: Publisher<ipc::Service, Raw<JointCommand>, ()>,
+    notifier: Notifier<ipc::Service>,
+    seq: u64,
+    _node: Node<ipc::Service>,
+}
+
+impl RawDaemon {
+    /// Opens the adapter's `commands` service under `prefix` (the adapter created it).
+    pub fn open(prefix: &str) -> anyhow::Result<Self> {
+        let node = node("hostile-daemon")?;
+        let commands = node
+            .service_builder(&service_name(prefix, "commands")?)
+            .publish_subscribe::<Raw<JointCommand>>()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening commands: {e:?}"))?;
+        let event = node
+            .service_builder(&service_name(prefix, "commands")?)
+            .event()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening the commands event: {e:?}"))?;
+        Ok(Self {
+            publisher: commands
+                .publisher_builder()
+                .create()
+                .map_err(|e| anyhow::anyhow!("publisher on commands: {e:?}"))?,
+            notifier: event
+                .notifier_builder()
+                .create()
+                .map_err(|e| anyhow::anyhow!("notifier on commands: {e:?}"))?,
+            seq: 0,
+            _node: node,
+        })
+    }
+
+    /// Publishes `command` (numbered and stamped) after `edit` changed its raw bytes.
+    pub fn publish(&mut self, command: &JointCommand, edit: impl FnOnce(&mut Raw<JointCommand>)) {
+        self.seq += 1;
+        let mut raw = Raw::of(*command);
+        raw.put(offset_of!(JointCommand, seq), self.seq);
+        raw.put(
+            offset_of!(JointCommand, timestamp_ns),
+            shm_types::monotonic_ns(),
+        );
+        edit(&mut raw);
+        let loan = self.publisher.loan_uninit().expect("loan a command");
+        loan.write_payload(raw).send().expect("send a command");
+        self.notifier.notify().expect("notify");
+    }
+}
+
 /// The `q_des` of a command (its first `dof` entries).
 pub fn command_q(command: &Raw<JointCommand>, dof: usize) -> Vec<f64> {
     let q: [f64; MAX_JOINTS] = command.get(offset_of!(JointCommand, q_des));
@@ -326,9 +378,12 @@ pub fn command_answers(command: &Raw<JointCommand>) -> u64 {
     command.get(offset_of!(JointCommand, answers_seq))
 }
 
+/// A client port of `control` with raw messages.
+type RawControlClient = Client<ipc::Service, Raw<ControlRequest>, (), Raw<ControlReply>, ()>;
+
 /// A client that sends raw control requests and raw submissions.
 pub struct RawClient {
-    control: Client<ipc::Service, Raw<ControlRequest>, (), Raw<ControlReply>, ()>,
+    control: RawControlClient,
     stances: Client<ipc::Service, [u8], (), Raw<SubmitReply>, ()>,
     _node: Node<ipc::Service>,
 }
@@ -410,10 +465,11 @@ impl RawClient {
     }
 }
 
-/// Holds as many ports of walkd's `control` clients and `status` subscribers as iceoryx2 lets
-/// one process take (at most `limit` each), as a greedy or leaking process would.
+/// Holds ports of walkd's services as a greedy or leaking process would: up to `limit`
+/// `control` clients and `status` subscribers, and `publishers` publishers on `sensors` (a
+/// second adapter).
 pub struct PortHog {
-    _control: Vec<Client<ipc::Service, Raw<ControlRequest>, (), Raw<ControlReply>, ()>>,
+    _control: Vec<RawControlClient>,
     _status: Vec<Subscriber<ipc::Service, Raw<DaemonStatus>, ()>>,
     _sensors: Vec<Publisher<ipc::Service, Raw<SensorSample>, ()>>,
     /// Ports taken: (control clients, status subscribers, sensor publishers).
@@ -422,8 +478,8 @@ pub struct PortHog {
 }
 
 impl PortHog {
-    /// Takes up to `limit` ports of each kind under `prefix`.
-    pub fn take(prefix: &str, limit: usize) -> anyhow::Result<Self> {
+    /// Takes the ports under `prefix`.
+    pub fn take(prefix: &str, limit: usize, publishers: usize) -> anyhow::Result<Self> {
         let node = node("hostile-hog")?;
         let control = node
             .service_builder(&service_name(prefix, "control")?)
@@ -446,7 +502,7 @@ impl PortHog {
         let status: Vec<_> = (0..limit)
             .map_while(|_| status.subscriber_builder().create().ok())
             .collect();
-        let sensors: Vec<_> = (0..limit)
+        let sensors: Vec<_> = (0..publishers)
             .map_while(|_| sensors.publisher_builder().create().ok())
             .collect();
         Ok(Self {

@@ -333,8 +333,12 @@ impl LoopState {
             imu_orientation: Some(m.base_orientation),
         };
         let started = Instant::now();
-        controller.tick(&measurement, dt, command);
+        let commanded = controller.tick(&measurement, dt, command);
         let stepped = Instant::now();
+        if !commanded {
+            // Only before a first valid measurement: the simulator's never is invalid.
+            return Err(PhysicsOutcome::Fault(controller.status().fault));
+        }
         let result = sim.step(command.q_des.as_slice(), command.qd_des.as_slice(), dt);
         self.physics_time += stepped.elapsed();
         self.controller_time += stepped - started;

@@ -98,8 +98,8 @@ impl Verdict {
         let submitted_at = state_at(states, submitted_ns).map_or(0.0, |s| s.sim_time_s);
         // The flag is sticky: the end state says whether a fall happened at all, even if the
         // state where it first fired was lost.
-        let fell_at_s = end.fallen.then(|| {
-            let first = states.iter().find(|s| s.fallen).unwrap_or(&end);
+        let fell_at_s = end.fallen.is_set().then(|| {
+            let first = states.iter().find(|s| s.fallen.is_set()).unwrap_or(&end);
             first.sim_time_s - submitted_at
         });
         Some(Self {
@@ -159,7 +159,7 @@ mod verdict_tests {
             timestamp_ns: seq * 1000,
             sim_time_s: seq as f64 * 0.5,
             tilt_rad,
-            fallen,
+            fallen: fallen.into(),
             ..SimTruth::ZERO
         }
     }

@@ -91,7 +91,13 @@ pub enum WalkError {
     Refused(#[from] crate::controller::Refusal),
     /// The simulator refused the start state or a command.
     #[error("simulator: {0}")]
-    Sim(#[from] kinematic_sim::SimError),
+    Sim(kinematic_sim::SimError),
+}
+
+impl From<kinematic_sim::SimError> for WalkError {
+    fn from(error: kinematic_sim::SimError) -> Self {
+        Self::Sim(error)
+    }
 }
 
 /// Executes `sequence` on `robot` (starting from its standing posture) in closed loop with the
@@ -128,8 +134,12 @@ pub fn walk(
             imu_orientation: Some(m.base_orientation),
         };
         let started = Instant::now();
-        controller.tick(&measurement, dt, &mut command);
+        let commanded = controller.tick(&measurement, dt, &mut command);
         let tick_ns = started.elapsed().as_nanos() as u64;
+        if !commanded {
+            // Only before a first valid measurement: the simulator's never is invalid.
+            break Outcome::Fault(controller.status().fault);
+        }
         sim.step(command.q_des.as_slice(), command.qd_des.as_slice(), dt)?;
         observe(&TickObservation {
             tick: ticks,

@@ -248,7 +248,8 @@ fn measure(args: &Args, walk: &str, rate_hz: f64, load: Load) -> anyhow::Result<
     };
     let walking = client
         .submit(walk.as_bytes(), Duration::from_secs(10))?
-        .accepted;
+        .accepted
+        .is_set();
     let walkd_pid = system.0[0].id();
     let (cpu_start, wall_start) = (cpu_seconds(walkd_pid)?, Instant::now());
     std::thread::sleep(Duration::from_secs(args.seconds));

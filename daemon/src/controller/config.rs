@@ -1,8 +1,9 @@
 //! The `[controller]` section of a robot config: task weights and gains, limits margins,
 //! trajectory speeds, tolerances, contact thresholds and timeouts.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use kinematics::{ConfigFile, ConfigFileError};
 use serde::Deserialize;
 
 /// Controller tuning from the `[controller]` section; every key is optional (defaults below suit
@@ -110,6 +111,21 @@ pub struct ControllerConfig {
     /// makes the stance foot slip about its vertical axis; a robot with heavy arms and little
     /// ankle roll (ARMAR-4) cannot balance with the arm left out to the side.
     pub carry_released_hands: bool,
+    /// A joint measured this far beyond its URDF limits is an invalid measurement (an encoder
+    /// or calibration fault): the controller faults, naming the joint (rad).
+    pub joint_limit_tolerance_rad: f64,
+    /// Every target of a sequence lies within this horizontal distance of where its first
+    /// stance stands (m).
+    pub workspace_radius_m: f64,
+    /// ... no lower than this below the first stance's soles (m) ...
+    pub workspace_depth_m: f64,
+    /// ... and no higher than this above them (m).
+    pub workspace_height_m: f64,
+    /// An end-effector's target moves at most this far from one stance to the next (m): a
+    /// swing, a step or a reach, never a jump across the room.
+    pub max_target_step_m: f64,
+    /// Longest planned duration of one phase (s); with `phase_timeout_s` it bounds every phase.
+    pub max_phase_s: f64,
 }
 
 impl Default for ControllerConfig {
@@ -158,6 +174,12 @@ impl Default for ControllerConfig {
             unload_foot_weight: 100.0,
             tipping_detection_rad: 0.25,
             carry_released_hands: false,
+            joint_limit_tolerance_rad: 0.03,
+            workspace_radius_m: 100.0,
+            workspace_depth_m: 1.0,
+            workspace_height_m: 3.0,
+            max_target_step_m: 1.0,
+            max_phase_s: 60.0,
         }
     }
 }
@@ -165,22 +187,9 @@ impl Default for ControllerConfig {
 /// Why the `[controller]` section could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
-    /// The file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        /// The config file.
-        path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
-    },
-    /// The file is not valid TOML.
-    #[error("{path}: invalid TOML: {source}")]
-    Toml {
-        /// The config file.
-        path: PathBuf,
-        /// The parse error.
-        source: toml::de::Error,
-    },
+    /// The config file could not be read or parsed.
+    #[error(transparent)]
+    File(#[from] ConfigFileError),
     /// The `[controller]` section is missing, has an unknown key or a badly typed value.
     #[error("{origin}: [controller]: {message}")]
     Section {
@@ -204,29 +213,18 @@ pub enum ConfigError {
 }
 
 impl ControllerConfig {
-    /// Reads the `[controller]` section of a robot config file.
+    /// Reads the `[controller]` section of the robot config file at `path`.
     pub fn from_config_file(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-        let table: toml::Table = text.parse().map_err(|source| ConfigError::Toml {
-            path: path.to_owned(),
-            source,
-        })?;
-        Self::from_section(&table, &path.display().to_string())
+        Self::from_config(&ConfigFile::load(path)?)
     }
 
-    /// Reads the `[controller]` section of an already parsed robot config.
-    pub fn from_toml_table(table: &toml::Table) -> Result<Self, ConfigError> {
-        Self::from_section(table, "<table>")
-    }
-
-    fn from_section(table: &toml::Table, origin: &str) -> Result<Self, ConfigError> {
-        let section = table
-            .get("controller")
+    /// Reads the `[controller]` section of a loaded robot config.
+    pub fn from_config(file: &ConfigFile) -> Result<Self, ConfigError> {
+        let origin = file.origin();
+        let section = file
+            .section("controller")
             .ok_or_else(|| ConfigError::Section {
-                origin: origin.to_owned(),
+                origin: origin.clone(),
                 message: "section missing".to_owned(),
             })?;
         let config: Self =
@@ -234,10 +232,10 @@ impl ControllerConfig {
                 .clone()
                 .try_into()
                 .map_err(|e: toml::de::Error| ConfigError::Section {
-                    origin: origin.to_owned(),
+                    origin: origin.clone(),
                     message: e.message().to_owned(),
                 })?;
-        config.validate(origin)?;
+        config.validate(&origin)?;
         Ok(config)
     }
 
@@ -289,6 +287,12 @@ impl ControllerConfig {
             ("command_lead_max_rad", self.command_lead_max_rad),
             ("unload_foot_weight", self.unload_foot_weight),
             ("tipping_detection_rad", self.tipping_detection_rad),
+            ("joint_limit_tolerance_rad", self.joint_limit_tolerance_rad),
+            ("workspace_radius_m", self.workspace_radius_m),
+            ("workspace_depth_m", self.workspace_depth_m),
+            ("workspace_height_m", self.workspace_height_m),
+            ("max_target_step_m", self.max_target_step_m),
+            ("max_phase_s", self.max_phase_s),
         ];
         let non_negative = [
             ("joint_limit_margin_rad", self.joint_limit_margin_rad),
@@ -334,23 +338,27 @@ impl ControllerConfig {
 mod tests {
     use super::*;
 
+    fn parse(text: &str) -> Result<ControllerConfig, ConfigError> {
+        ControllerConfig::from_config(&ConfigFile::parse(text, Path::new("r.toml")).unwrap())
+    }
+
     #[test]
     fn unknown_key_is_an_error_naming_it() {
-        let table: toml::Table = "[controller]\ncom_wieght = 1.0\n".parse().unwrap();
-        let error = ControllerConfig::from_toml_table(&table)
+        let error = parse("[controller]\ncom_wieght = 1.0\n")
             .unwrap_err()
             .to_string();
-        assert!(error.contains("com_wieght"), "{error}");
+        assert!(
+            error.contains("r.toml") && error.contains("com_wieght"),
+            "{error}"
+        );
     }
 
     #[test]
     fn partial_section_keeps_defaults_and_bad_values_are_named() {
-        let table: toml::Table = "[controller]\ncom_weight = 3.0\n".parse().unwrap();
-        let config = ControllerConfig::from_toml_table(&table).unwrap();
+        let config = parse("[controller]\ncom_weight = 3.0\n").unwrap();
         assert_eq!(config.com_weight, 3.0);
         assert_eq!(config.foot_weight, ControllerConfig::default().foot_weight);
-        let table: toml::Table = "[controller]\nlower_speed = -1.0\n".parse().unwrap();
-        let error = ControllerConfig::from_toml_table(&table)
+        let error = parse("[controller]\nlower_speed = -1.0\n")
             .unwrap_err()
             .to_string();
         assert!(error.contains("lower_speed"), "{error}");

@@ -364,7 +364,8 @@ impl StateMachine {
             (phase, None) => unreachable!("phase {phase:?} needs an end-effector"),
             (Phase::None, _) => unreachable!("plans hold no empty phase"),
         };
-        self.deadline = duration + timeout;
+        // However far a target, a phase that does not complete faults in bounded time.
+        self.deadline = duration.min(c.max_phase_s) + timeout;
     }
 
     /// A motion from `start` to `goal` at the configured swing speeds.

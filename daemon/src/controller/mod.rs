@@ -18,6 +18,14 @@
 //!
 //! A failed solve, an invalid measurement or a phase timeout holds the last safe command and
 //! enters [`ControllerState::Fault`].
+//!
+//! Joint limits are a hard guarantee: every command written is finite and inside the URDF
+//! limits. A measurement is invalid when it has the wrong size, a non-finite value, or a joint
+//! beyond its limits by more than `joint_limit_tolerance_rad` (a fault naming the joint). Until
+//! the first valid measurement after start-up or an adapter restart ([`Controller::relink`])
+//! there is no safe command at all, and [`Controller::tick`] writes none (the adapter keeps
+//! holding on its own); after it, hold keeps the last command, which is always inside the
+//! limits, also for a joint that is then measured outside them.
 
 mod assembly;
 mod config;
@@ -37,7 +45,9 @@ use nalgebra::{DVector, Isometry3, UnitQuaternion};
 
 pub use config::{ConfigError, ControllerConfig};
 pub use sequence::{PreparedSequence, Refusal};
-pub use status::{ControllerState, ControllerStatus, FaultCode, Phase};
+pub use status::{
+    ControllerState, ControllerStatus, FaultCode, FaultDescription, MeasurementFault, Phase,
+};
 
 use assembly::QpAssembler;
 use estimator::BaseEstimator;
@@ -78,6 +88,55 @@ pub struct Measurement<'a> {
     /// Base orientation if the adapter has an IMU (sets up the world frame on the first tick;
     /// leg odometry estimates the base afterwards, see `estimator`).
     pub imu_orientation: Option<UnitQuaternion<f64>>,
+}
+
+/// Why [`Controller::start`] gave a sequence back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StartRefusal {
+    /// Another sequence is executing.
+    Busy,
+    /// The controller is in fault (acknowledge it with [`Controller::reset`]).
+    Faulted,
+    /// The last measurement was invalid (or the adapter restarted since): nothing to start from.
+    NoMeasurement,
+    /// The IMU shows the robot tilted beyond `tipping_detection_rad` from upright.
+    NotUpright,
+}
+
+impl StartRefusal {
+    /// Why, for the submitter.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Busy => "busy: a sequence is executing; hold or abort it first",
+            Self::Faulted => "the controller is in fault; send hold or abort to acknowledge it",
+            Self::NoMeasurement => {
+                "no valid measurement from the adapter yet: the sequence cannot start"
+            }
+            Self::NotUpright => {
+                "the robot is not upright (its IMU is tilted beyond tipping_detection_rad): \
+                 stand it up first"
+            }
+        }
+    }
+}
+
+/// Why [`Controller::reset`] did not acknowledge a fault.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ResetRefusal {
+    /// A tipping fault stays until the IMU shows the robot upright again.
+    NotUpright,
+}
+
+impl ResetRefusal {
+    /// What a person must do.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::NotUpright => {
+                "the robot is not upright (its IMU is tilted beyond tipping_detection_rad): stand \
+                 it upright (or restart the simulator), then send hold again"
+            }
+        }
+    }
 }
 
 /// Whether the actuators should track the command or hold position.
@@ -131,8 +190,15 @@ pub struct Controller {
     assembler: QpAssembler,
     solution: Vec<f64>,
     poses: [Isometry3<f64>; 4],
+    /// The last command written; inside the joint limits whenever `world_ready`.
     last_command: DVector<f64>,
+    /// The world frame is set up from a valid measurement, so `last_command` is a safe command.
     world_ready: bool,
+    /// The last measurement was refused, or the adapter restarted since: no walk may start
+    /// until a valid one comes.
+    measurement_refused: bool,
+    /// The IMU orientation of the last valid measurement.
+    last_imu: Option<UnitQuaternion<f64>>,
     status: ControllerStatus,
 }
 
@@ -165,6 +231,8 @@ impl Controller {
             poses: [Isometry3::identity(); 4],
             last_command: robot.standing.joints.clone(),
             world_ready: false,
+            measurement_refused: false,
+            last_imu: None,
             status: ControllerStatus::default(),
             solver,
             config,
@@ -181,50 +249,57 @@ impl Controller {
         PreparedSequence::new(robot, config, seq)
     }
 
-    /// RT: begins executing `seq` from Idle, Holding or Done. Returns the previously held
-    /// sequence (drop it off the RT thread); gives `seq` back while executing or in Fault (call
-    /// [`reset`](Self::reset) first).
+    /// RT: begins executing `seq` (from the next tick) in Idle, Holding or Done, unless the
+    /// last measurement was refused or the IMU shows the robot tilted. Returns the previously held sequence (drop it off the RT
+    /// thread); gives `seq` back with the reason otherwise.
+    #[allow(clippy::type_complexity)]
     pub fn start(
         &mut self,
         seq: Box<PreparedSequence>,
-    ) -> Result<Option<Box<PreparedSequence>>, Box<PreparedSequence>> {
-        match self.status.state {
-            ControllerState::Executing | ControllerState::Fault => Err(seq),
-            _ => {
-                let previous = self.machine.load(seq);
-                self.status.state = ControllerState::Executing;
-                self.status.stance_index = 0;
-                self.status.stance_count = self.machine.progress().1 as u32;
-                Ok(previous)
-            }
+    ) -> Result<Option<Box<PreparedSequence>>, (Box<PreparedSequence>, StartRefusal)> {
+        let refusal = match self.status.state {
+            ControllerState::Executing => Some(StartRefusal::Busy),
+            ControllerState::Fault => Some(StartRefusal::Faulted),
+            _ if self.measurement_refused => Some(StartRefusal::NoMeasurement),
+            _ if !self.upright() => Some(StartRefusal::NotUpright),
+            _ => None,
+        };
+        if let Some(refusal) = refusal {
+            return Err((seq, refusal));
         }
+        let previous = self.machine.load(seq);
+        self.status.state = ControllerState::Executing;
+        self.status.fault = FaultCode::None;
+        self.status.stance_index = 0;
+        self.status.stance_count = self.machine.progress().1 as u32;
+        Ok(previous)
     }
 
-    /// RT: one control step; see the module docs. Never writes NaN or out-of-limit values.
-    pub fn tick(&mut self, measurement: &Measurement, dt: f64, out: &mut Command) {
+    /// RT: one control step; see the module docs. Returns whether `out` holds a command: false
+    /// until a valid measurement has set up the world (then there is no safe posture to
+    /// command, and `out` is left as it is). A written command is never NaN or out of limits.
+    #[must_use]
+    pub fn tick(&mut self, measurement: &Measurement, dt: f64, out: &mut Command) -> bool {
         self.status.ticks += 1;
-        if !self.measurement_valid(measurement, dt) {
-            self.enter_fault(FaultCode::InvalidMeasurement);
-            self.write_hold(out);
-            return;
+        if let Err(fault) = self.check_measurement(measurement, dt) {
+            return self.refuse_measurement(fault, out);
         }
+        self.measurement_refused = false;
+        self.last_imu = measurement.imu_orientation;
         self.configuration.joints.copy_from_slice(measurement.q);
         if !self.world_ready {
             self.initialise_world(measurement);
         }
         if !self.estimate(measurement) {
             self.enter_fault(FaultCode::LostSupport);
-            self.write_hold(out);
-            return;
+            return self.write_hold(out);
         }
         if self.tipping(measurement) {
             self.enter_fault(FaultCode::Tipping);
-            self.write_hold(out);
-            return;
+            return self.write_hold(out);
         }
         if self.status.state != ControllerState::Executing {
-            self.write_hold(out);
-            return;
+            return self.write_hold(out);
         }
         let feedback = Feedback {
             com: self.kinematics.com(),
@@ -238,13 +313,11 @@ impl Controller {
                 // Keep holding the last command: it carries the servo offsets of the load.
                 self.status.state = ControllerState::Done;
                 self.publish_progress();
-                self.write_hold(out);
-                return;
+                return self.write_hold(out);
             }
             Progress::Fault(code) => {
                 self.enter_fault(code);
-                self.write_hold(out);
-                return;
+                return self.write_hold(out);
             }
         }
         self.publish_progress();
@@ -275,11 +348,32 @@ impl Controller {
                     QpError::Infeasible => FaultCode::QpInfeasible,
                     _ => FaultCode::QpFailed,
                 });
-                self.write_hold(out);
-                return;
+                return self.write_hold(out);
             }
         }
-        self.write_track(measurement, dt, out);
+        self.write_track(measurement, dt, out)
+    }
+
+    /// RT: a measurement that could not even be decoded (e.g. a flag byte that is neither 0
+    /// nor 1) or failed its checks: fault with `fault` and hold. Returns whether `out` holds
+    /// a command (see [`Controller::tick`]).
+    #[must_use]
+    pub fn refuse_measurement(&mut self, fault: MeasurementFault, out: &mut Command) -> bool {
+        self.measurement_refused = true;
+        self.enter_fault(FaultCode::InvalidMeasurement(fault));
+        self.write_hold(out)
+    }
+
+    /// RT: the adapter restarted, or its link came back after the watchdog tripped: the robot
+    /// may stand anywhere now. The world frame, the base estimate and the hold posture are set
+    /// up again from the next valid measurement (no command until then); a walk in progress
+    /// faults with [`FaultCode::AdapterRestarted`].
+    pub fn relink(&mut self) {
+        if self.status.state == ControllerState::Executing {
+            self.enter_fault(FaultCode::AdapterRestarted);
+        }
+        self.world_ready = false;
+        self.measurement_refused = true;
     }
 
     /// RT: stops executing and holds the current posture (→ Holding).
@@ -298,13 +392,23 @@ impl Controller {
         self.status.phase = Phase::None;
     }
 
-    /// RT: acknowledges a fault (→ Holding the last safe command); no effect otherwise.
-    pub fn reset(&mut self) {
-        if self.status.state == ControllerState::Fault {
-            self.machine.stop();
-            self.status.state = ControllerState::Holding;
-            self.status.phase = Phase::None;
+    /// RT: acknowledges a fault (→ Holding the last safe command); no effect otherwise. A
+    /// tipping fault is acknowledged only once the IMU shows the robot upright; the world frame
+    /// and the base estimate then restart from the next measurement.
+    pub fn reset(&mut self) -> Result<(), ResetRefusal> {
+        if self.status.state != ControllerState::Fault {
+            return Ok(());
         }
+        if self.status.fault == FaultCode::Tipping {
+            if !self.upright() {
+                return Err(ResetRefusal::NotUpright);
+            }
+            self.world_ready = false;
+        }
+        self.machine.stop();
+        self.status.state = ControllerState::Holding;
+        self.status.phase = Phase::None;
+        Ok(())
     }
 
     /// The status of the last tick.
@@ -327,16 +431,51 @@ impl Controller {
         &self.robot
     }
 
-    fn measurement_valid(&self, m: &Measurement, dt: f64) -> bool {
+    /// The first thing wrong with `m`, if anything: size, finiteness, joint limits.
+    fn check_measurement(&self, m: &Measurement, dt: f64) -> Result<(), MeasurementFault> {
         let dof = self.robot.model.dof();
-        m.q.len() == dof
-            && m.qd.len() == dof
-            && m.q.iter().chain(m.qd).all(|v| v.is_finite())
-            && m.wrenches.iter().flatten().all(|v| v.is_finite())
-            && m.imu_orientation
-                .is_none_or(|r| r.coords.iter().all(|v| v.is_finite()))
-            && dt.is_finite()
-            && dt > 0.0
+        if m.q.len() != dof || m.qd.len() != dof {
+            return Err(MeasurementFault::JointCount(m.q.len() as u32));
+        }
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(MeasurementFault::BadTimeStep);
+        }
+        let tolerance = self.config.joint_limit_tolerance_rad;
+        for (j, limit) in self.robot.model.joint_limits().iter().enumerate() {
+            let (q, qd) = (m.q[j], m.qd[j]);
+            if !q.is_finite() {
+                return Err(MeasurementFault::NonFiniteAngle(j as u16));
+            }
+            if !qd.is_finite() {
+                return Err(MeasurementFault::NonFiniteVelocity(j as u16));
+            }
+            if q < limit.lower - tolerance || q > limit.upper + tolerance {
+                return Err(MeasurementFault::OutsideLimits(j as u16));
+            }
+        }
+        if let Some(k) = m
+            .wrenches
+            .iter()
+            .position(|w| !w.iter().all(|v| v.is_finite()))
+        {
+            return Err(MeasurementFault::NonFiniteWrench(k as u8));
+        }
+        if m.imu_orientation
+            .is_some_and(|r| !r.coords.iter().all(|v| v.is_finite()))
+        {
+            return Err(MeasurementFault::NonFiniteImu);
+        }
+        Ok(())
+    }
+
+    /// Whether the last IMU reading (if any) shows the base within `tipping_detection_rad` of
+    /// its standing orientation's vertical. Without an IMU the robot counts as upright.
+    fn upright(&self) -> bool {
+        self.last_imu.is_none_or(|imu| {
+            let relative = imu * self.robot.standing.base.rotation.inverse();
+            (relative * nalgebra::Vector3::z()).angle(&nalgebra::Vector3::z())
+                <= self.config.tipping_detection_rad
+        })
     }
 
     /// Sets up the world frame on the first valid measurement and anchors the standing feet.
@@ -349,7 +488,15 @@ impl Controller {
         );
         self.update_poses();
         self.machine.set_standing(standing, &self.poses);
-        self.last_command.copy_from_slice(measurement.q);
+        // The measurement may lie up to the tolerance beyond a limit; the command may not.
+        for ((command, &q), limit) in self
+            .last_command
+            .iter_mut()
+            .zip(measurement.q)
+            .zip(self.robot.model.joint_limits())
+        {
+            *command = q.clamp(limit.lower, limit.upper);
+        }
         self.world_ready = true;
     }
 
@@ -399,6 +546,7 @@ impl Controller {
         self.status.contacts = self.machine.targets().contacts;
     }
 
+    /// Enters `Fault` with `code`; a fault already present is kept (it is the first cause).
     fn enter_fault(&mut self, code: FaultCode) {
         if self.status.state == ControllerState::Fault {
             return;
@@ -408,23 +556,26 @@ impl Controller {
         self.status.fault = code;
     }
 
-    /// Holds `last_command`: the last command written (the measured posture before the first one).
-    fn write_hold(&self, out: &mut Command) {
+    /// Holds `last_command`, if there is a safe one; returns whether `out` holds a command.
+    fn write_hold(&self, out: &mut Command) -> bool {
+        if !self.world_ready {
+            return false;
+        }
         out.q_des.copy_from(&self.last_command);
         out.qd_des.fill(0.0);
         out.mode = CommandMode::Hold;
+        true
     }
 
     /// Integrates `q_des ← q_des + q̇·dt` from the last command (`last_command`), within
     /// `command_lead_max_rad` of the measured angle and inside the joint limits; non-finite →
-    /// fault and hold.
-    fn write_track(&mut self, measurement: &Measurement, dt: f64, out: &mut Command) {
+    /// fault and hold. Returns true (a command is written either way).
+    fn write_track(&mut self, measurement: &Measurement, dt: f64, out: &mut Command) -> bool {
         let limits = self.robot.model.joint_limits();
         let qd = &self.solution[6..];
         if qd.iter().any(|v| !v.is_finite()) {
             self.enter_fault(FaultCode::NonFiniteCommand);
-            self.write_hold(out);
-            return;
+            return self.write_hold(out);
         }
         let lead = self.config.command_lead_max_rad;
         for (j, limit) in limits.iter().enumerate() {
@@ -438,6 +589,7 @@ impl Controller {
         }
         out.mode = CommandMode::Track;
         self.last_command.copy_from(&out.q_des);
+        true
     }
 }
 

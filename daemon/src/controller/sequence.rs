@@ -108,8 +108,62 @@ impl PreparedSequence {
             });
         }
         check_step_sizes(&stances, config.max_step_m)?;
+        check_workspace(&stances, config)?;
         Ok(Self { stances })
     }
+}
+
+/// Refuses targets outside the workspace the config allows: beyond `workspace_radius_m`
+/// (horizontally) of where the first stance stands, more than `workspace_depth_m` below or
+/// `workspace_height_m` above its soles, or more than `max_target_step_m` from the same
+/// end-effector's target in the stance before.
+fn check_workspace(stances: &[PreparedStance], config: &ControllerConfig) -> Result<(), Refusal> {
+    let first = &stances[0];
+    let feet: Vec<_> = [EndEffector::LeftFoot, EndEffector::RightFoot]
+        .into_iter()
+        .filter(|f| first.contacts[*f as usize])
+        .map(|f| first.targets[f as usize].translation.vector)
+        .collect();
+    let centre = feet.iter().sum::<nalgebra::Vector3<f64>>() / feet.len() as f64;
+    let ground = feet.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    for (i, stance) in stances.iter().enumerate() {
+        for e in EndEffector::ALL {
+            let target = stance.targets[e as usize].translation.vector;
+            let (x, y, z) = (target.x, target.y, target.z);
+            let distance = (target - centre).xy().norm();
+            if distance > config.workspace_radius_m {
+                return Err(Refusal(format!(
+                    "stance {i}: {} target ({x:.3}, {y:.3}, {z:.3}) lies {distance:.3e} m from where \
+                     the walk starts, beyond workspace_radius_m = {}",
+                    e.name(),
+                    config.workspace_radius_m
+                )));
+            }
+            if z < ground - config.workspace_depth_m || z > ground + config.workspace_height_m {
+                return Err(Refusal(format!(
+                    "stance {i}: {} target at height {z:.3} m is outside the workspace ({} m below \
+                     to {} m above the first stance's soles)",
+                    e.name(),
+                    config.workspace_depth_m,
+                    config.workspace_height_m
+                )));
+            }
+            if i > 0 {
+                let previous = stances[i - 1].targets[e as usize].translation.vector;
+                let step = (target - previous).norm();
+                if step > config.max_target_step_m {
+                    return Err(Refusal(format!(
+                        "stance {i}: {} target moves {step:.3} m from stance {}, more than \
+                         max_target_step_m = {}",
+                        e.name(),
+                        i - 1,
+                        config.max_target_step_m
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Refuses steps (between consecutive contact poses of one foot) longer than `max_step`.

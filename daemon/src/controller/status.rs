@@ -1,5 +1,7 @@
 //! Plain `Copy` status data the controller publishes every tick (state, phase, fault, estimates).
 
+use kinematics::robot::Robot;
+
 /// The top-level state of the controller.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum ControllerState {
@@ -73,8 +75,10 @@ pub enum FaultCode {
     /// No fault.
     #[default]
     None,
-    /// The measurement had the wrong size or a NaN/infinite entry.
-    InvalidMeasurement,
+    /// The measurement could not be used; the detail says what was wrong with it.
+    InvalidMeasurement(MeasurementFault),
+    /// The adapter restarted (or its link came back) while a sequence executed.
+    AdapterRestarted,
     /// The QP had no feasible point.
     QpInfeasible,
     /// The QP solver failed (iterations, numerics, bad input).
@@ -95,12 +99,16 @@ impl FaultCode {
     pub fn describe(self) -> &'static str {
         match self {
             Self::None => "no fault",
-            Self::InvalidMeasurement => "invalid measurement (wrong size or non-finite value)",
+            Self::InvalidMeasurement(_) => "invalid measurement",
+            Self::AdapterRestarted => "the adapter restarted during the walk",
             Self::QpInfeasible => "QP infeasible",
             Self::QpFailed => "QP solver failed",
             Self::NonFiniteCommand => "non-finite command",
             Self::LostSupport => "no foot in contact",
-            Self::Tipping => "tipping: IMU and leg odometry disagree on the base orientation",
+            Self::Tipping => {
+                "tipping: IMU and leg odometry disagree on the base orientation; stand the robot \
+                 upright, then send hold to acknowledge"
+            }
             Self::Timeout(Phase::ShiftCom) => "timeout: CoM shift did not reach its target",
             Self::Timeout(Phase::Unload) => {
                 "timeout: foot force did not drop below the release threshold"
@@ -118,7 +126,8 @@ impl FaultCode {
     pub fn code(self) -> &'static str {
         match self {
             Self::None => "none",
-            Self::InvalidMeasurement => "invalid_measurement",
+            Self::InvalidMeasurement(_) => "invalid_measurement",
+            Self::AdapterRestarted => "adapter_restarted",
             Self::QpInfeasible => "qp_infeasible",
             Self::QpFailed => "qp_failed",
             Self::NonFiniteCommand => "non_finite_command",
@@ -134,6 +143,85 @@ impl FaultCode {
             Self::Timeout(Phase::None) => "timeout",
         }
     }
+}
+
+impl FaultCode {
+    /// The description with its details (the joint concerned, by name); writes without
+    /// allocating, so the real-time thread can put it into a status text.
+    pub fn describe_for(self, robot: &Robot) -> FaultDescription<'_> {
+        FaultDescription { fault: self, robot }
+    }
+}
+
+/// [`FaultCode::describe_for`]: a fault described with the robot's joint names.
+pub struct FaultDescription<'a> {
+    fault: FaultCode,
+    robot: &'a Robot,
+}
+
+impl core::fmt::Display for FaultDescription<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let FaultCode::InvalidMeasurement(detail) = self.fault else {
+            return f.write_str(self.fault.describe());
+        };
+        let names = self.robot.model.joint_names();
+        let name = |j: u16| names.get(usize::from(j)).map_or("?", String::as_str);
+        f.write_str("invalid measurement: ")?;
+        match detail {
+            MeasurementFault::JointCount(count) => write!(
+                f,
+                "{count} joints, the robot has {}",
+                self.robot.model.dof()
+            ),
+            MeasurementFault::NonFiniteAngle(j) => write!(f, "q of {} is not finite", name(j)),
+            MeasurementFault::NonFiniteVelocity(j) => {
+                write!(f, "q̇ of {} is not finite", name(j))
+            }
+            MeasurementFault::NonFiniteWrench(k) => write!(f, "wrench {k} is not finite"),
+            MeasurementFault::NonFiniteImu => f.write_str("the IMU orientation is not finite"),
+            MeasurementFault::OutsideLimits(j) => {
+                let limits = self.robot.model.joint_limits()[usize::from(j)];
+                write!(
+                    f,
+                    "joint {} is measured outside its limits [{:.4}, {:.4}] (an encoder or \
+                     calibration fault?)",
+                    name(j),
+                    limits.lower,
+                    limits.upper
+                )
+            }
+            MeasurementFault::BadFlag { field, value } => {
+                write!(f, "{field} holds {value}, expected 0 or 1")
+            }
+            MeasurementFault::BadTimeStep => f.write_str("the time step is not positive"),
+        }
+    }
+}
+
+/// What made a measurement unusable (see [`FaultCode::InvalidMeasurement`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeasurementFault {
+    /// The sample carries this many joints, not the robot's number.
+    JointCount(u32),
+    /// A joint angle (model index) is NaN or infinite.
+    NonFiniteAngle(u16),
+    /// A joint velocity is NaN or infinite.
+    NonFiniteVelocity(u16),
+    /// A wrench (`EndEffector` index) has a NaN or infinite entry.
+    NonFiniteWrench(u8),
+    /// The IMU orientation has a NaN or infinite entry.
+    NonFiniteImu,
+    /// A joint is measured beyond its limits by more than `joint_limit_tolerance_rad`.
+    OutsideLimits(u16),
+    /// A flag of the sample holds neither 0 nor 1.
+    BadFlag {
+        /// The field.
+        field: &'static str,
+        /// Its byte.
+        value: u8,
+    },
+    /// The control period is not a positive number.
+    BadTimeStep,
 }
 
 /// Everything a client or log needs about the controller, updated every tick (plain data).

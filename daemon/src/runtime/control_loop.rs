@@ -21,22 +21,34 @@
 //! Lockstep clock: one tick per received sample, no sleeping; the watchdog trips after
 //! `lockstep_timeout` of wall time without a sample.
 //!
+//! Samples pass a [`SampleGate`] first: one stamped in the future or older than the last is
+//! refused and counted, so the grid only ever follows time that has passed. A new adapter run
+//! (sequence numbers start over) or a link back from stale makes the controller set up its
+//! world and hold posture again from the next measurement ([`Controller::relink`]). A sample
+//! the controller cannot use (an undecodable flag, a joint outside its limits, NaN) faults it;
+//! until it has had one valid measurement there is no safe posture, and no command goes out
+//! (the adapter holds on its own). The status's fault text keeps the first cause of a fault
+//! and adds what followed ([`FaultLog`]); a second process publishing on `sensors` stops any
+//! walk and is reported there too.
+//!
 //! After start-up nothing here allocates, frees, locks or logs per tick.
 
 use std::sync::Arc;
 use std::time::Duration;
 
-use nalgebra::{Quaternion, UnitQuaternion};
 use shm_types::{
-    ClockMode, ControlCommand, DaemonLoopPorts, DaemonState, DaemonStatus, FixedText, LinkState,
-    SensorSample, ShmError, monotonic_ns, sleep_until,
+    ClockMode, Code, ControlCommand, DaemonLoopPorts, DaemonState, DaemonStatus, FixedText,
+    LinkState, SensorSample, ShmError, monotonic_ns, sleep_until,
 };
 
-use super::shared::{Shared, StartOutcome};
+use super::decode;
+use super::fault_log::FaultLog;
+use super::sample_gate::{SampleGate, Verdict};
+use super::shared::{ControlOutcome, Shared, StartOutcome};
 use super::snapshot::SnapshotWriter;
 use super::stats::{LoopStats, MissRecord, log_histogram, record, summarize};
 use crate::controller::{
-    Command, CommandMode, Controller, ControllerState, FaultCode, Measurement, PreparedSequence,
+    Command, CommandMode, Controller, ControllerState, FaultCode, PreparedSequence,
 };
 
 /// Longest single blocking wait, so stop requests and submissions are seen quickly.
@@ -82,7 +94,11 @@ pub struct ControlLoop {
     status_out: SnapshotWriter<DaemonStatus>,
     timing: LoopTiming,
     dof: usize,
+    /// The sample being answered (the last one the gate accepted).
     sample: SensorSample,
+    /// Where a received sample waits for the gate's verdict.
+    incoming: SensorSample,
+    gate: SampleGate,
     /// When the loop took `sample` from the subscriber.
     sample_taken_ns: u64,
     command: Command,
@@ -91,7 +107,9 @@ pub struct ControlLoop {
     link: LinkState,
     stale_in_row: u32,
     sequence_id: u64,
-    last_fault: &'static str,
+    faults: FaultLog,
+    /// More than one process publishes on `sensors` (checked with each status).
+    second_adapter: bool,
     last_state: ControllerState,
     /// A sequence to free that did not fit into the outbox yet (never freed here).
     release_later: Option<Box<PreparedSequence>>,
@@ -111,7 +129,7 @@ impl ControlLoop {
         let dof = controller.robot().model.dof();
         let mut status = DaemonStatus::INITIAL;
         status.pid = std::process::id();
-        status.clock = timing.clock;
+        status.clock = Code::new(timing.clock);
         status.rate_hz = 1e9 / timing.period_ns as f64;
         Self {
             controller,
@@ -121,6 +139,8 @@ impl ControlLoop {
             timing,
             dof,
             sample: SensorSample::ZERO,
+            incoming: SensorSample::ZERO,
+            gate: SampleGate::new(),
             sample_taken_ns: 0,
             command: Command::new(dof),
             command_seq: 0,
@@ -128,7 +148,8 @@ impl ControlLoop {
             link: LinkState::Waiting,
             stale_in_row: 0,
             sequence_id: 0,
-            last_fault: "",
+            faults: FaultLog::new(),
+            second_adapter: false,
             last_state: ControllerState::Idle,
             release_later: None,
             status,
@@ -145,7 +166,9 @@ impl ControlLoop {
         };
         self.controller.hold();
         if self.command_seq > 0 {
+            // The last command sent is a safe one (inside the limits): hold it.
             self.command.mode = CommandMode::Hold;
+            self.command.qd_des.fill(0.0);
             self.send_command()?;
         }
         self.write_status(DaemonState::Stopping);
@@ -194,8 +217,9 @@ impl ControlLoop {
                 if stamped >= end {
                     // Stamped in a later period (the adapter was late, or our wait overslept):
                     // the periods before it went without a sample; answer it in its own period.
+                    // The gate refused stamps in the future, so this never runs ahead of now.
                     let skipped = (stamped - period_start) / period;
-                    self.stats.stale_periods += skipped;
+                    self.stats.stale_periods = self.stats.stale_periods.saturating_add(skipped);
                     end += skipped * period;
                     expected += skipped * period;
                 }
@@ -205,7 +229,8 @@ impl ControlLoop {
                 if times.sent_ns > end {
                     // Our command is late, and every period we overran stays unanswered.
                     let late = times.sent_ns - end;
-                    self.stats.deadline_misses += 1 + late / period;
+                    self.stats.deadline_misses =
+                        self.stats.deadline_misses.saturating_add(1 + late / period);
                     let miss = MissRecord {
                         at_ns: tick_start - loop_start,
                         wake_late_ns: wake_late,
@@ -222,7 +247,10 @@ impl ControlLoop {
                 self.stale_period();
                 let now = monotonic_ns();
                 if now > end {
-                    self.stats.stale_periods += (now - end) / period;
+                    self.stats.stale_periods = self
+                        .stats
+                        .stale_periods
+                        .saturating_add((now - end) / period);
                 }
                 now
             };
@@ -249,8 +277,7 @@ impl ControlLoop {
     /// system call: the subscriber reads shared memory and the clock is read through the vDSO.
     fn spin_for_current_sample(&mut self, start: u64, until: u64) -> Result<bool, ShmError> {
         loop {
-            if self.ports.take_latest_sample(&mut self.sample)? {
-                self.sample_taken_ns = monotonic_ns();
+            if self.take_sample()? {
                 if self.sample.timestamp_ns >= start {
                     return Ok(true);
                 }
@@ -306,8 +333,7 @@ impl ControlLoop {
     /// submission or a control command is handled meanwhile. Leaves it in `self.sample`.
     fn wait_for_sample_until(&mut self, deadline_ns: u64) -> Result<bool, ShmError> {
         loop {
-            if self.ports.take_latest_sample(&mut self.sample)? {
-                self.sample_taken_ns = monotonic_ns();
+            if self.take_sample()? {
                 return Ok(true);
             }
             let now = monotonic_ns();
@@ -322,42 +348,64 @@ impl ControlLoop {
         }
     }
 
+    /// Takes the newest sample into `self.sample` if one arrived and the gate accepts it; a
+    /// new adapter run makes the controller set up again from it.
+    fn take_sample(&mut self) -> Result<bool, ShmError> {
+        if !self.ports.take_latest_sample(&mut self.incoming)? {
+            return Ok(false);
+        }
+        let taken = monotonic_ns();
+        match self.gate.judge(&self.incoming, taken) {
+            Verdict::Reject => return Ok(false),
+            Verdict::Restarted => self.controller.relink(),
+            Verdict::Accept => {}
+        }
+        std::mem::swap(&mut self.sample, &mut self.incoming);
+        self.sample_taken_ns = taken;
+        Ok(true)
+    }
+
     /// One control step on `self.sample`. Between taking the sample and sending the command
     /// only the controller runs; submissions, control requests and the status come after.
     fn tick(&mut self, tick_start: u64) -> Result<TickTimes, ShmError> {
+        if self.link == LinkState::Stale {
+            // Whatever happened while the link was down, start from what is measured now.
+            self.controller.relink();
+        }
         self.link = LinkState::Fresh;
         self.stale_in_row = 0;
-        let n = (self.sample.joint_count as usize).min(self.sample.q.len());
-        let imu = self.sample.has_imu.then(|| {
-            let [x, y, z, w] = self.sample.imu_orientation;
-            UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z))
-        });
-        let measurement = Measurement {
-            q: &self.sample.q[..n],
-            qd: &self.sample.qd[..n],
-            wrenches: &self.sample.wrenches,
-            imu_orientation: imu,
-        };
-        let dt = self.timing.period_ns as f64 * 1e-9;
-        self.controller.tick(&measurement, dt, &mut self.command);
+        let commanded = self.control_step();
         let computed_ns = monotonic_ns();
-        self.send_command()?;
+        if commanded {
+            self.send_command()?;
+        }
         let sent_ns = monotonic_ns();
         record(&mut self.stats.tick, computed_ns - tick_start);
-        record(
-            &mut self.stats.latency,
-            sent_ns.saturating_sub(self.sample.timestamp_ns),
-        );
+        if commanded {
+            record(
+                &mut self.stats.latency,
+                sent_ns.saturating_sub(self.sample.timestamp_ns),
+            );
+        }
         self.stats.ticks += 1;
-        self.note_state_change();
+        let changed = self.note_state_change();
         self.housekeeping();
-        if sent_ns >= self.next_status_ns {
+        if changed || sent_ns >= self.next_status_ns {
             self.write_status(self.daemon_state());
         }
         Ok(TickTimes {
             computed_ns,
             sent_ns,
         })
+    }
+
+    /// Decodes `self.sample` and ticks the controller on it; returns whether a command is ready.
+    fn control_step(&mut self) -> bool {
+        let dt = self.timing.period_ns as f64 * 1e-9;
+        match decode::measurement(&self.sample, self.dof) {
+            Ok(measurement) => self.controller.tick(&measurement, dt, &mut self.command),
+            Err(fault) => self.controller.refuse_measurement(fault, &mut self.command),
+        }
     }
 
     fn send_command(&mut self) -> Result<(), ShmError> {
@@ -368,10 +416,10 @@ impl ControlLoop {
             out.seq = seq;
             out.answers_seq = answers;
             out.joint_count = n as u32;
-            out.mode = match command.mode {
+            out.mode = Code::new(match command.mode {
                 CommandMode::Hold => shm_types::CommandMode::Hold,
                 CommandMode::Track => shm_types::CommandMode::Track,
-            };
+            });
             out.q_des[..n].copy_from_slice(command.q_des.as_slice());
             out.qd_des[..n].copy_from_slice(command.qd_des.as_slice());
         })
@@ -379,7 +427,7 @@ impl ControlLoop {
 
     /// Realtime: a period ended without a fresh sample.
     fn stale_period(&mut self) {
-        self.stats.stale_periods += 1;
+        self.stats.stale_periods = self.stats.stale_periods.saturating_add(1);
         self.stale_in_row += 1;
         if self.stale_in_row >= self.timing.watchdog_periods {
             self.trip_watchdog();
@@ -393,7 +441,8 @@ impl ControlLoop {
         }
         self.link = LinkState::Stale;
         self.stats.watchdog_trips += 1;
-        self.last_fault = "adapter link stale: no fresh sensor sample within the watchdog time";
+        self.faults
+            .record("adapter link stale: no fresh sensor sample within the watchdog time");
         if self.controller.status().state == ControllerState::Executing {
             self.controller.hold();
         }
@@ -414,18 +463,8 @@ impl ControlLoop {
             self.release(sequence);
         }
         if let Some(command) = self.shared.take_control() {
-            match command {
-                ControlCommand::Hold => {
-                    self.controller.reset();
-                    self.controller.hold();
-                }
-                ControlCommand::Abort => {
-                    self.controller.reset();
-                    self.controller.abort();
-                }
-                ControlCommand::Query => {}
-            }
-            self.shared.control_done();
+            let outcome = self.carry_out(command);
+            self.shared.control_done(outcome);
             self.note_state_change();
             self.write_status(self.daemon_state());
         }
@@ -433,6 +472,9 @@ impl ControlLoop {
             let outcome = if self.link != LinkState::Fresh {
                 self.release(submission.sequence);
                 StartOutcome::AdapterStale
+            } else if self.second_adapter {
+                self.release(submission.sequence);
+                StartOutcome::SecondAdapter
             } else {
                 match self.controller.start(submission.sequence) {
                     Ok(previous) => {
@@ -440,22 +482,35 @@ impl ControlLoop {
                             self.release(previous);
                         }
                         self.sequence_id = submission.id;
+                        self.faults.clear();
                         StartOutcome::Started
                     }
-                    Err(refused) => {
+                    Err((refused, why)) => {
                         self.release(refused);
-                        if self.controller.status().state == ControllerState::Fault {
-                            StartOutcome::Faulted
-                        } else {
-                            StartOutcome::Busy
-                        }
+                        StartOutcome::Refused(why)
                     }
                 }
             };
-            self.shared.report_start(submission.id, outcome);
+            self.shared.report_start(submission.ticket, outcome);
             self.note_state_change();
             self.write_status(self.daemon_state());
         }
+    }
+
+    /// Hold or abort: acknowledges a fault (if it can be) and holds.
+    fn carry_out(&mut self, command: ControlCommand) -> ControlOutcome {
+        if command == ControlCommand::Query {
+            return ControlOutcome::Done;
+        }
+        if let Err(refusal) = self.controller.reset() {
+            return ControlOutcome::NotAcknowledged(refusal);
+        }
+        match command {
+            ControlCommand::Abort => self.controller.abort(),
+            _ => self.controller.hold(),
+        }
+        self.faults.clear();
+        ControlOutcome::Done
     }
 
     /// Hands a sequence to the service thread to free (or keeps it until the outbox is free).
@@ -465,14 +520,40 @@ impl ControlLoop {
         }
     }
 
-    /// Remembers the fault of a controller that just entered Fault.
-    fn note_state_change(&mut self) {
+    /// Follows the controller's state: records the cause of a new fault, forgets old faults
+    /// when a walk ends `done`. Returns whether the state changed.
+    fn note_state_change(&mut self) -> bool {
         let status = self.controller.status();
-        if status.state != self.last_state {
-            if status.state == ControllerState::Fault && status.fault != FaultCode::None {
-                self.last_fault = status.fault.describe();
+        if status.state == self.last_state {
+            return false;
+        }
+        match status.state {
+            ControllerState::Fault if status.fault != FaultCode::None => {
+                self.faults
+                    .record(status.fault.describe_for(self.controller.robot()));
             }
-            self.last_state = status.state;
+            ControllerState::Done => self.faults.clear(),
+            _ => {}
+        }
+        self.last_state = status.state;
+        true
+    }
+
+    /// Checks that only one process publishes sensor samples; a second one stops any walk and
+    /// is reported until it is gone.
+    fn check_adapters(&mut self) {
+        let publishers = self.ports.sensor_publishers();
+        if publishers > 1 && !self.second_adapter {
+            self.second_adapter = true;
+            self.faults.record(format_args!(
+                "{publishers} processes publish on sensors (publishers): only one adapter may; \
+                 stop the other one"
+            ));
+            if self.controller.status().state == ControllerState::Executing {
+                self.controller.hold();
+            }
+        } else if publishers <= 1 {
+            self.second_adapter = false;
         }
     }
 
@@ -488,10 +569,11 @@ impl ControlLoop {
 
     /// Writes a status snapshot for the service thread. No allocation.
     fn write_status(&mut self, state: DaemonState) {
+        self.check_adapters();
         let controller = self.controller.status();
         let status = &mut self.status;
         status.timestamp_ns = monotonic_ns();
-        status.state = state;
+        status.state = Code::new(state);
         status.sequence_id = self.sequence_id;
         status.stance_index = controller.stance_index;
         status.stance_count = controller.stance_count;
@@ -499,9 +581,11 @@ impl ControlLoop {
         status.com = controller.com;
         status.left_foot = controller.left_foot;
         status.right_foot = controller.right_foot;
-        status.fault = FixedText::new(self.last_fault);
-        status.link = self.link;
+        status.fault = *self.faults.text();
+        status.link = Code::new(self.link);
         status.adapter_holding = self.sample.adapter_holding;
+        status.rejected_samples = self.gate.rejected();
+        status.last_rejection = *self.gate.last_rejection();
         status.ticks = self.stats.ticks;
         status.deadline_misses = self.stats.deadline_misses;
         status.stale_periods = self.stats.stale_periods;

@@ -17,8 +17,11 @@
 //! version), 5 controller could not be built.
 
 mod control_loop;
+pub mod decode;
+mod fault_log;
 mod handoff;
 mod realtime;
+mod sample_gate;
 mod service;
 mod shared;
 mod snapshot;
@@ -29,6 +32,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
 
+use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::process::{exit_code, install_termination_handler, termination_requested};
 use shm_types::{
@@ -37,7 +41,7 @@ use shm_types::{
 
 use crate::controller::{Controller, ControllerConfig, SolverKind};
 use control_loop::{ControlLoop, LoopTiming};
-use service::ServiceLoop;
+use service::{ServiceLoop, SubmissionLimits};
 use shared::Shared;
 
 /// Command line of the daemon (flattened into `walkd`'s top level).
@@ -115,8 +119,10 @@ fn load(args: &DaemonArgs) -> Result<Setup, Failure> {
             "--config CONFIG is required to run the daemon"
         ))
     })?;
-    let mut runtime =
-        RuntimeConfig::from_config_file(config).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
+    // The config file is read and parsed once; each part validates its own section.
+    let file = ConfigFile::load(config).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
+    let mut runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())
+        .map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
     if let Some(rate) = args.rate_hz {
         if !(rate.is_finite() && rate > 0.0) {
             return Err(fail(exit_code::USAGE)(anyhow::anyhow!(
@@ -138,10 +144,10 @@ fn load(args: &DaemonArgs) -> Result<Setup, Failure> {
     if let Some(spin_us) = args.spin_us {
         runtime.spin_us = spin_us;
     }
-    let robot =
-        Robot::load(config, args.urdf.as_deref()).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
-    let controller_config = ControllerConfig::from_config_file(config)
+    let robot = Robot::from_config(&file, args.urdf.as_deref())
         .map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
+    let controller_config =
+        ControllerConfig::from_config(&file).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
     Ok(Setup {
         runtime,
         robot: Arc::new(robot),
@@ -189,6 +195,10 @@ fn run(args: &DaemonArgs) -> Result<(), Failure> {
         status_in,
         robot,
         controller_config,
+        SubmissionLimits {
+            max_bytes: runtime.max_submission_bytes,
+            max_stances: runtime.max_stances,
+        },
         runtime.status_rate_hz,
     );
     let _ = sd_notify::notify(&[sd_notify::NotifyState::Ready]);

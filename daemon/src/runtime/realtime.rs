@@ -1,16 +1,32 @@
 //! Real-time process and thread settings; each degrades to a warning when not permitted.
 
-/// Locks all current and future memory so page faults cannot stall the control loop.
+/// Locks memory so page faults cannot stall the control loop: everything mapped now is faulted
+/// in and locked (`MCL_CURRENT`), and every page mapped later is locked once it is first
+/// touched (`MCL_FUTURE | MCL_ONFAULT`). Touched-on-fault rather than all at once, so a large
+/// reservation (a thread stack, a shared-memory segment sized for the largest submission)
+/// locks only what is used; [`release_free_memory`] returns what a finished walk freed.
 pub fn lock_memory() {
     // SAFETY: mlockall has no memory-safety preconditions.
-    if unsafe { libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) } != 0 {
+    let locked = unsafe {
+        libc::mlockall(libc::MCL_CURRENT) == 0
+            && libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE | libc::MCL_ONFAULT) == 0
+    };
+    if locked {
+        tracing::info!("memory locked (mlockall: current, future on fault)");
+    } else {
         tracing::warn!(
             error = %std::io::Error::last_os_error(),
             "mlockall not permitted: memory stays pageable (raise RLIMIT_MEMLOCK or grant CAP_IPC_LOCK)"
         );
-    } else {
-        tracing::info!("memory locked (mlockall)");
     }
+}
+
+/// Hands memory the allocator keeps after frees (a parsed submission, a finished walk) back to
+/// the operating system, so walkd's resident and locked memory shrink again. Service thread
+/// only: it may take the allocator's locks.
+pub fn release_free_memory() {
+    // SAFETY: malloc_trim only releases free heap memory; it has no preconditions.
+    unsafe { libc::malloc_trim(0) };
 }
 
 /// Gives the calling thread SCHED_FIFO at `priority`; returns whether it was granted.

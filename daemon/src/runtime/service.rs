@@ -2,19 +2,34 @@
 //!
 //! Everything that may allocate or block happens here: parsing and validating submitted JSON,
 //! preparing sequences, freeing the ones the control thread hands back.
+//!
+//! A submission is bounded before it is parsed: its size against `[runtime]
+//! max_submission_bytes`, then whether a walk is executing ("busy" needs no parsing), then its
+//! stance count against `max_stances` (counted without building the stances). Memory freed
+//! after a walk or a refused submission is handed back to the operating system.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use kinematics::robot::Robot;
 use shm_types::{
-    ControlCommand, ControlReply, DaemonServicePorts, DaemonState, DaemonStatus, FixedText,
-    LinkState, ShmError, SubmitReply,
+    Code, ControlCommand, ControlReply, DaemonServicePorts, DaemonState, DaemonStatus, DecodeError,
+    FixedText, Flag, LinkState, ShmError, SubmitReply,
 };
 
-use super::shared::{Shared, StartOutcome, Submission};
+use super::realtime::release_free_memory;
+use super::shared::{ControlOutcome, Shared, StartOutcome, Submission};
 use super::snapshot::SnapshotReader;
 use crate::controller::{Controller, ControllerConfig};
+
+/// How large a submission walkd reads (`[runtime]` keys).
+#[derive(Debug, Clone, Copy)]
+pub struct SubmissionLimits {
+    /// `max_submission_bytes`.
+    pub max_bytes: usize,
+    /// `max_stances`.
+    pub max_stances: usize,
+}
 
 /// How long the service thread waits for the control thread to take a request.
 const HANDOFF_TIMEOUT: Duration = Duration::from_secs(2);
@@ -26,8 +41,8 @@ pub struct ServiceLoop {
     ports: DaemonServicePorts,
     requests: Requests,
     status_interval: Duration,
-    last_notified_state: Option<DaemonState>,
-    last_link: LinkState,
+    last_notified_state: Option<Code<DaemonState>>,
+    last_link: Code<LinkState>,
     /// systemd's watchdog interval (`WATCHDOG_USEC`), if it watches us.
     watchdog: Option<Duration>,
 }
@@ -38,7 +53,9 @@ struct Requests {
     status_in: SnapshotReader<DaemonStatus>,
     robot: Arc<Robot>,
     config: ControllerConfig,
+    limits: SubmissionLimits,
     next_sequence_id: u64,
+    next_ticket: u64,
 }
 
 impl ServiceLoop {
@@ -49,6 +66,7 @@ impl ServiceLoop {
         status_in: SnapshotReader<DaemonStatus>,
         robot: Arc<Robot>,
         config: ControllerConfig,
+        limits: SubmissionLimits,
         status_rate_hz: f64,
     ) -> Self {
         Self {
@@ -58,11 +76,13 @@ impl ServiceLoop {
                 status_in,
                 robot,
                 config,
+                limits,
                 next_sequence_id: 1,
+                next_ticket: 1,
             },
             status_interval: Duration::from_secs_f64(1.0 / status_rate_hz),
             last_notified_state: None,
-            last_link: LinkState::Waiting,
+            last_link: Code::new(LinkState::Waiting),
             watchdog: sd_notify::watchdog_enabled(),
         }
     }
@@ -72,7 +92,10 @@ impl ServiceLoop {
         let mut next_status = Instant::now();
         while keep_running() {
             let requests = &mut self.requests;
-            drop(requests.shared.outbox.take());
+            if let Some(finished) = requests.shared.outbox.take() {
+                drop(finished);
+                release_free_memory();
+            }
             let served_submission = self
                 .ports
                 .serve_submission(|json| requests.handle_submission(json))?;
@@ -100,13 +123,13 @@ impl ServiceLoop {
         self.feed_watchdog();
         let link_changed = status.link != self.last_link;
         if link_changed {
-            match status.link {
-                LinkState::Stale => tracing::warn!(
+            if status.link == LinkState::Stale {
+                tracing::warn!(
                     state = status.state.name(),
                     "adapter link stale: no fresh sensor samples, holding"
-                ),
-                LinkState::Fresh => tracing::info!("adapter link fresh"),
-                LinkState::Waiting => {}
+                );
+            } else if status.link == LinkState::Fresh {
+                tracing::info!("adapter link fresh");
             }
             self.last_link = status.link;
         }
@@ -155,12 +178,14 @@ impl Requests {
     }
 
     fn try_submit(&mut self, json: &[u8]) -> Result<u64, String> {
-        let text = std::str::from_utf8(json)
-            .map_err(|e| format!("the submission is not UTF-8 JSON: {e}"))?;
-        let sequence = stance::PostProcessedSequence::from_json_str(text, &self.robot)
-            .map_err(|e| format!("invalid sequence: {e}"))?;
-        let prepared =
-            Controller::prepare(&self.robot, &self.config, &sequence).map_err(|e| e.to_string())?;
+        let limits = self.limits;
+        if json.len() > limits.max_bytes {
+            return Err(format!(
+                "the submission has {} bytes, more than [runtime] max_submission_bytes = {}",
+                json.len(),
+                limits.max_bytes
+            ));
+        }
         let status = self.status_in.read();
         if status.state == DaemonState::Executing {
             return Err(format!(
@@ -168,10 +193,29 @@ impl Requests {
                 status.sequence_id, status.stance_index, status.stance_count
             ));
         }
+        let text = std::str::from_utf8(json)
+            .map_err(|e| format!("the submission is not UTF-8 JSON: {e}"))?;
+        let stances =
+            stance::format::count_stances(text).map_err(|e| format!("invalid sequence: {e}"))?;
+        if stances > limits.max_stances {
+            return Err(format!(
+                "the sequence has {stances} stances, more than [runtime] max_stances = {}",
+                limits.max_stances
+            ));
+        }
+        let prepared = stance::PostProcessedSequence::from_json_str(text, &self.robot)
+            .map_err(|e| format!("invalid sequence: {e}"))
+            .and_then(|sequence| {
+                Controller::prepare(&self.robot, &self.config, &sequence).map_err(|e| e.to_string())
+            });
+        // Parsing a large file leaves freed memory behind: hand it back now.
+        release_free_memory();
+        let prepared = prepared?;
         drop(self.shared.outbox.take());
-        let id = self.next_sequence_id;
-        self.next_sequence_id += 1;
+        let (id, ticket) = (self.next_sequence_id, self.next_ticket);
+        self.next_ticket += 1;
         let submission = Box::new(Submission {
+            ticket,
             id,
             sequence: Box::new(prepared),
         });
@@ -180,18 +224,20 @@ impl Requests {
         }
         let start = Instant::now();
         loop {
-            if let Some(outcome) = self.shared.start_outcome(id) {
+            if let Some(outcome) = self.shared.start_outcome(ticket) {
                 return match outcome {
-                    StartOutcome::Started => Ok(id),
-                    StartOutcome::Busy => {
-                        Err("busy: a sequence is executing; hold or abort it first".to_owned())
+                    StartOutcome::Started => {
+                        self.next_sequence_id += 1;
+                        Ok(id)
                     }
-                    StartOutcome::Faulted => Err(
-                        "the controller is in fault; send hold or abort to acknowledge it"
-                            .to_owned(),
-                    ),
+                    StartOutcome::Refused(refusal) => Err(refusal.describe().to_owned()),
                     StartOutcome::AdapterStale => Err(
                         "no fresh sensor samples from the adapter: the sequence cannot start"
+                            .to_owned(),
+                    ),
+                    StartOutcome::SecondAdapter => Err(
+                        "more than one process publishes on sensors: stop the other adapter \
+                         first"
                             .to_owned(),
                     ),
                 };
@@ -203,27 +249,54 @@ impl Requests {
         }
     }
 
-    /// Carries out hold / abort through the control thread, or answers a query.
-    fn handle_control(&mut self, command: ControlCommand) -> ControlReply {
+    /// Carries out hold / abort through the control thread, or answers a query; refuses a
+    /// command code the contract does not define, naming it.
+    fn handle_control(&mut self, command: Result<ControlCommand, DecodeError>) -> ControlReply {
         let mut reply = ControlReply {
-            accepted: true,
-            message: FixedText::new(command.name()),
+            accepted: Flag::YES,
+            message: FixedText::EMPTY,
             status: self.status_in.read(),
         };
+        let command = match command {
+            Ok(command) => command,
+            Err(error) => {
+                tracing::warn!(%error, "control request refused");
+                reply.accepted = Flag::NO;
+                reply.message = FixedText::new(&format!("refused: unknown command: {error}"));
+                return reply;
+            }
+        };
+        reply.message = FixedText::new(command.name());
         if command == ControlCommand::Query {
             return reply;
         }
         let target = self.shared.request_control(command);
         let start = Instant::now();
-        while self.shared.controls_done() < target {
+        let outcome = loop {
+            if let Some(outcome) = self.shared.control_outcome(target) {
+                break outcome;
+            }
             if start.elapsed() > HANDOFF_TIMEOUT {
-                reply.accepted = false;
+                reply.accepted = Flag::NO;
                 reply.message = FixedText::new("the control loop did not answer in time");
                 return reply;
             }
             std::thread::sleep(POLL);
+        };
+        match outcome {
+            ControlOutcome::Done => {
+                tracing::info!(command = command.name(), "control command carried out")
+            }
+            ControlOutcome::NotAcknowledged(refusal) => {
+                tracing::warn!(command = command.name(), "fault not acknowledged");
+                reply.accepted = Flag::NO;
+                reply.message = FixedText::new(&format!(
+                    "{} refused: {}",
+                    command.name(),
+                    refusal.describe()
+                ));
+            }
         }
-        tracing::info!(command = command.name(), "control command carried out");
         reply.status = self.status_in.read();
         reply
     }

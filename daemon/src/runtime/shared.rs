@@ -5,11 +5,13 @@ use std::sync::atomic::{AtomicBool, AtomicU8, AtomicU64, Ordering};
 use shm_types::ControlCommand;
 
 use super::handoff::Slot;
-use crate::controller::PreparedSequence;
+use crate::controller::{PreparedSequence, ResetRefusal, StartRefusal};
 
 /// A prepared sequence on its way to the control thread.
 pub struct Submission {
-    /// Id the daemon gave the sequence.
+    /// Numbers every hand-over (refused ones too), so an outcome is never mistaken for another's.
+    pub ticket: u64,
+    /// Id the sequence gets if it starts (ids count started sequences only).
     pub id: u64,
     /// The prepared sequence.
     pub sequence: Box<PreparedSequence>,
@@ -17,24 +19,58 @@ pub struct Submission {
 
 /// How the control thread answered a submission.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[repr(u8)]
 pub enum StartOutcome {
     /// Executing it.
-    Started = 1,
-    /// Another sequence is executing.
-    Busy = 2,
-    /// The controller is in fault (hold or abort acknowledges it).
-    Faulted = 3,
+    Started,
+    /// The controller refused to start it (busy, in fault, no valid measurement, not upright).
+    Refused(StartRefusal),
     /// No fresh samples from the adapter: nothing could execute it.
-    AdapterStale = 4,
+    AdapterStale,
+    /// More than one process publishes sensor samples: none can be trusted.
+    SecondAdapter,
 }
 
 impl StartOutcome {
-    fn from_code(code: u8) -> Option<Self> {
-        [Self::Started, Self::Busy, Self::Faulted, Self::AdapterStale]
-            .into_iter()
-            .find(|outcome| *outcome as u8 == code)
+    const REFUSALS: [StartRefusal; 4] = [
+        StartRefusal::Busy,
+        StartRefusal::Faulted,
+        StartRefusal::NoMeasurement,
+        StartRefusal::NotUpright,
+    ];
+
+    fn code(self) -> u8 {
+        match self {
+            Self::Started => 1,
+            Self::AdapterStale => 2,
+            Self::SecondAdapter => 3,
+            Self::Refused(refusal) => {
+                10 + Self::REFUSALS
+                    .iter()
+                    .position(|r| *r == refusal)
+                    .unwrap_or(0) as u8
+            }
+        }
     }
+
+    fn from_code(code: u8) -> Option<Self> {
+        match code {
+            1 => Some(Self::Started),
+            2 => Some(Self::AdapterStale),
+            3 => Some(Self::SecondAdapter),
+            _ => Self::REFUSALS
+                .get(usize::from(code.checked_sub(10)?))
+                .map(|r| Self::Refused(*r)),
+        }
+    }
+}
+
+/// How the control thread carried out a hold or abort.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ControlOutcome {
+    /// Done: holding (a fault was acknowledged).
+    Done,
+    /// The fault could not be acknowledged yet.
+    NotAcknowledged(ResetRefusal),
 }
 
 /// The state both threads see.
@@ -43,12 +79,14 @@ pub struct Shared {
     pub inbox: Slot<Submission>,
     /// Control → service thread: sequences to free (replaced or refused ones).
     pub outbox: Slot<PreparedSequence>,
-    /// Control → service thread: `id << 8 | StartOutcome` of the last submission taken.
+    /// Control → service thread: `ticket << 8 | StartOutcome` of the last submission taken.
     start_result: AtomicU64,
     /// Service → control thread: a pending hold/abort (`ControlCommand as u8 + 1`, 0: none).
     control: AtomicU8,
     /// Control → service thread: count of control commands carried out.
     controls_done: AtomicU64,
+    /// Control → service thread: whether the last one acknowledged its fault (0) or not (1).
+    control_refused: AtomicU8,
     /// Main → control thread: shut down.
     pub stop: AtomicBool,
     /// Control → service thread: when the control loop last went round (CLOCK_MONOTONIC ns),
@@ -65,6 +103,7 @@ impl Shared {
             start_result: AtomicU64::new(0),
             control: AtomicU8::new(0),
             controls_done: AtomicU64::new(0),
+            control_refused: AtomicU8::new(0),
             stop: AtomicBool::new(false),
             heartbeat_ns: AtomicU64::new(shm_types::monotonic_ns()),
         }
@@ -80,16 +119,16 @@ impl Shared {
         self.heartbeat_ns.load(Ordering::Relaxed)
     }
 
-    /// Control thread: reports how submission `id` went.
-    pub fn report_start(&self, id: u64, outcome: StartOutcome) {
+    /// Control thread: reports how the submission with `ticket` went.
+    pub fn report_start(&self, ticket: u64, outcome: StartOutcome) {
         self.start_result
-            .store(id << 8 | outcome as u64, Ordering::Release);
+            .store(ticket << 8 | u64::from(outcome.code()), Ordering::Release);
     }
 
-    /// Service thread: the outcome for submission `id`, once reported.
-    pub fn start_outcome(&self, id: u64) -> Option<StartOutcome> {
+    /// Service thread: the outcome for the submission with `ticket`, once reported.
+    pub fn start_outcome(&self, ticket: u64) -> Option<StartOutcome> {
         let value = self.start_result.load(Ordering::Acquire);
-        (value >> 8 == id)
+        (value >> 8 == ticket)
             .then(|| StartOutcome::from_code((value & 0xff) as u8))
             .flatten()
     }
@@ -101,9 +140,15 @@ impl Shared {
         target
     }
 
-    /// Service thread: how many control commands the control thread carried out.
-    pub fn controls_done(&self) -> u64 {
-        self.controls_done.load(Ordering::Acquire)
+    /// Service thread: the outcome of the last control command once `target` (from
+    /// [`Shared::request_control`]) of them were carried out.
+    pub fn control_outcome(&self, target: u64) -> Option<ControlOutcome> {
+        (self.controls_done.load(Ordering::Acquire) >= target).then(|| {
+            match self.control_refused.load(Ordering::Acquire) {
+                0 => ControlOutcome::Done,
+                _ => ControlOutcome::NotAcknowledged(ResetRefusal::NotUpright),
+            }
+        })
     }
 
     /// Control thread: takes the pending control command, if any.
@@ -120,8 +165,10 @@ impl Shared {
         }
     }
 
-    /// Control thread: marks a control command as carried out.
-    pub fn control_done(&self) {
+    /// Control thread: marks a control command as carried out, with its outcome.
+    pub fn control_done(&self, outcome: ControlOutcome) {
+        let refused = u8::from(outcome != ControlOutcome::Done);
+        self.control_refused.store(refused, Ordering::Release);
         self.controls_done.fetch_add(1, Ordering::AcqRel);
     }
 }

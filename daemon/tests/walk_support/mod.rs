@@ -221,8 +221,11 @@ impl Harness {
             wrenches: &wrenches,
             imu_orientation: Some(m.base_orientation),
         };
-        self.controller
-            .tick(&measurement, self.dt, &mut self.command);
+        assert!(
+            self.controller
+                .tick(&measurement, self.dt, &mut self.command),
+            "the simulator's measurements are valid, so every tick commands"
+        );
         self.sim
             .step(
                 self.command.q_des.as_slice(),

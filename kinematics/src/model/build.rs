@@ -258,6 +258,13 @@ fn joint_model(
         };
         return Ok((origin * motion, JointMotion::Fixed, None));
     }
+    if limits.velocity.is_nan() || limits.velocity <= 0.0 {
+        // The controller moves a joint at most at its velocity limit: 0 would freeze it.
+        return Err(ModelError::ZeroVelocityLimit {
+            joint: joint.name.clone(),
+            velocity: limits.velocity,
+        });
+    }
     let motion = if prismatic {
         JointMotion::Prismatic {
             axis,

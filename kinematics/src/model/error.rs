@@ -6,12 +6,12 @@ use super::InertiaDefect;
 #[derive(Debug, thiserror::Error)]
 pub enum ModelError {
     /// The file could not be read.
-    #[error("cannot read URDF file {path}: {source}")]
+    #[error("cannot read the URDF file: {error}")]
     Io {
         /// The file.
         path: String,
         /// The cause.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The XML is malformed.
     #[error("malformed URDF XML at byte {position}: {message}")]
@@ -94,6 +94,14 @@ pub enum ModelError {
         velocity: f64,
         /// Effort limit.
         effort: f64,
+    },
+    /// An actuated joint's velocity limit is zero (it could never move).
+    #[error("joint '{joint}': velocity limit {velocity} (an actuated joint needs a positive one)")]
+    ZeroVelocityLimit {
+        /// The joint.
+        joint: String,
+        /// The velocity limit found.
+        velocity: f64,
     },
     /// The joint axis is the zero vector.
     #[error("joint '{0}': zero-length <axis>")]

@@ -124,9 +124,9 @@ pub struct Model {
 impl Model {
     /// Reads and validates a URDF file.
     pub fn from_urdf_path(path: &Path) -> Result<Model, ModelError> {
-        let xml = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
+        let xml = std::fs::read_to_string(path).map_err(|error| ModelError::Io {
             path: path.display().to_string(),
-            source,
+            error,
         })?;
         Self::from_urdf_str(&xml)
     }

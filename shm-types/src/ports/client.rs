@@ -1,65 +1,61 @@
 //! The client's ports: status, sequence submission and control of a running `walkd`.
+//!
+//! Each port is created when it is first needed, so a client that only watches the status does
+//! not take a `control` or `stances` slot, and one service whose slots another process holds
+//! does not lock a client out of the others.
 
 use core::time::Duration;
+use std::cell::OnceCell;
 
 use iceoryx2::pending_response::PendingResponse;
 use iceoryx2::port::client::Client;
-use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::subscriber::{Subscriber, SubscriberCreateError};
 use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::client::ClientCreateError;
 
-use crate::services::{self, Access, ControlService, IpcNode, PubSub, SubmitService};
+use crate::services::{self, Access, ControlService, IpcNode, PubSub, SubmitService, capacity};
 use crate::{
-    ControlCommand, ControlReply, ControlRequest, DaemonStatus, MAX_SEQUENCE_BYTES, ServiceNames,
-    ShmError, SubmitReply,
+    ControlCommand, ControlReply, ControlRequest, DaemonStatus, ServiceNames, ShmError, SubmitReply,
 };
 
 /// How often a waiting client looks for an answer.
 const POLL: Duration = Duration::from_millis(1);
 
+type StatusSubscriber = Subscriber<ipc::Service, DaemonStatus, ()>;
+type StancesClient = Client<ipc::Service, [u8], (), SubmitReply, ()>;
+type ControlClient = Client<ipc::Service, ControlRequest, (), ControlReply, ()>;
+
 /// Connection to a running daemon. Only opens services: if no daemon ever created them,
 /// [`connect`](Self::connect) fails with [`ShmError::NotRunning`].
 pub struct ClientPorts {
     names: ServiceNames,
-    status: Subscriber<ipc::Service, DaemonStatus, ()>,
-    stances: Client<ipc::Service, [u8], (), SubmitReply, ()>,
-    control: Client<ipc::Service, ControlRequest, (), ControlReply, ()>,
+    status: OnceCell<StatusSubscriber>,
+    stances: OnceCell<StancesClient>,
+    control: OnceCell<ControlClient>,
     status_service: PubSub<DaemonStatus>,
     stances_service: SubmitService,
-    _control_service: ControlService,
+    control_service: ControlService,
     _node: IpcNode,
 }
 
 impl ClientPorts {
-    /// Opens the daemon's `status`, `stances` and `control` services under `names`.
+    /// Opens the daemon's `status`, `stances` and `control` services under `names`, and
+    /// subscribes to the status right away if it can (so the newest one is delivered soon).
     pub fn connect(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, _) = services::create_node(node_name)?;
-        let status_service = services::status(&node, names, Access::OpenOnly)?;
-        let stances_service = services::stances(&node, names, Access::OpenOnly)?;
-        let control_service = services::control(&node, names, Access::OpenOnly)?;
-        let status = status_service
-            .subscriber_builder()
-            .create()
-            .map_err(|e| ShmError::ipc("create subscriber on", &names.full("status"), e))?;
-        let stances = stances_service
-            .client_builder()
-            .initial_max_slice_len(64 * 1024)
-            .allocation_strategy(AllocationStrategy::PowerOfTwo)
-            .create()
-            .map_err(|e| ShmError::ipc("create client on", &names.full("stances"), e))?;
-        let control = control_service
-            .client_builder()
-            .create()
-            .map_err(|e| ShmError::ipc("create client on", &names.full("control"), e))?;
-        Ok(Self {
+        let ports = Self {
             names: names.clone(),
-            status,
-            stances,
-            control,
-            status_service,
-            stances_service,
-            _control_service: control_service,
+            status_service: services::status(&node, names, Access::OpenOnly)?,
+            stances_service: services::stances(&node, names, Access::OpenOnly)?,
+            control_service: services::control(&node, names, Access::OpenOnly)?,
+            status: OnceCell::new(),
+            stances: OnceCell::new(),
+            control: OnceCell::new(),
             _node: node,
-        })
+        };
+        // A full status service is reported when the status is asked for, not here.
+        let _ = ports.status_subscriber();
+        Ok(ports)
     }
 
     /// Whether a live daemon serves these services (a status publisher and a stances server
@@ -69,17 +65,62 @@ impl ClientPorts {
             && self.stances_service.dynamic_config().number_of_servers() > 0
     }
 
+    fn status_subscriber(&self) -> Result<&StatusSubscriber, ShmError> {
+        created(&self.status, || {
+            self.status_service
+                .subscriber_builder()
+                .create()
+                .map_err(|e| {
+                    let service = self.names.full("status");
+                    match e {
+                        SubscriberCreateError::ExceedsMaxSupportedSubscribers => {
+                            ShmError::ServiceFull {
+                                service,
+                                port: "subscriber",
+                                limit: capacity::STATUS_SUBSCRIBERS,
+                            }
+                        }
+                        other => ShmError::ipc("create subscriber on", &service, other),
+                    }
+                })
+        })
+    }
+
+    fn stances_client(&self) -> Result<&StancesClient, ShmError> {
+        created(&self.stances, || {
+            self.stances_service
+                .client_builder()
+                .initial_max_slice_len(64 * 1024)
+                .allocation_strategy(AllocationStrategy::PowerOfTwo)
+                .create()
+                .map_err(|e| {
+                    client_error(&self.names.full("stances"), capacity::STANCES_CLIENTS, e)
+                })
+        })
+    }
+
+    fn control_client(&self) -> Result<&ControlClient, ShmError> {
+        created(&self.control, || {
+            self.control_service.client_builder().create().map_err(|e| {
+                client_error(&self.names.full("control"), capacity::CONTROL_CLIENTS, e)
+            })
+        })
+    }
+
     /// The newest status received since the last call, if any.
     pub fn latest_status(&self) -> Result<Option<DaemonStatus>, ShmError> {
+        let service = self.names.full("status");
+        let subscriber = self.status_subscriber()?;
         let mut latest = None;
-        while let Some(sample) = self
-            .status
+        while let Some(sample) = subscriber
             .receive()
-            .map_err(|e| ShmError::ipc("receive from", &self.names.full("status"), e))?
+            .map_err(|e| ShmError::ipc("receive from", &service, e))?
         {
             latest = Some(*sample.payload());
         }
-        Ok(latest)
+        latest
+            .map(|status| checked_status(&service, status))
+            .transpose()
     }
 
     /// Waits up to `timeout` for a status newer than the last one received.
@@ -89,20 +130,12 @@ impl ClientPorts {
     }
 
     /// Submits a post-processed sequence (its JSON) and waits up to `timeout` for the verdict.
+    /// The daemon bounds the size (`[runtime] max_submission_bytes`) and says so if it is
+    /// exceeded.
     pub fn submit(&self, json: &[u8], timeout: Duration) -> Result<SubmitReply, ShmError> {
         let service = self.names.full("stances");
-        if json.len() > MAX_SEQUENCE_BYTES {
-            return Err(ShmError::ipc(
-                "submit to",
-                &service,
-                format!(
-                    "sequence of {} bytes exceeds {MAX_SEQUENCE_BYTES}",
-                    json.len()
-                ),
-            ));
-        }
         let request = self
-            .stances
+            .stances_client()?
             .loan_slice_uninit(json.len())
             .map_err(|e| ShmError::ipc("loan a request on", &service, e))?;
         let pending = request
@@ -120,11 +153,44 @@ impl ClientPorts {
     ) -> Result<ControlReply, ShmError> {
         let service = self.names.full("control");
         let pending = self
-            .control
-            .send_copy(ControlRequest { command })
+            .control_client()?
+            .send_copy(ControlRequest::new(command))
             .map_err(|e| ShmError::ipc("send to", &service, e))?;
-        wait_for_reply(&service, timeout, &pending)
+        let reply = wait_for_reply(&service, timeout, &pending)?;
+        checked_status(&service, reply.status)?;
+        Ok(reply)
     }
+}
+
+/// The port in `cell`, created by `create` on first use.
+fn created<T>(
+    cell: &OnceCell<T>,
+    create: impl FnOnce() -> Result<T, ShmError>,
+) -> Result<&T, ShmError> {
+    if let Some(port) = cell.get() {
+        return Ok(port);
+    }
+    let port = create()?;
+    Ok(cell.get_or_init(|| port))
+}
+
+fn client_error(service: &str, limit: usize, error: ClientCreateError) -> ShmError {
+    match error {
+        ClientCreateError::ExceedsMaxSupportedClients => ShmError::ServiceFull {
+            service: service.to_owned(),
+            port: "client",
+            limit,
+        },
+        other => ShmError::ipc("create client on", service, other),
+    }
+}
+
+/// A status whose codes and flags the client can read, or an error naming the bad field.
+fn checked_status(service: &str, status: DaemonStatus) -> Result<DaemonStatus, ShmError> {
+    status
+        .validate()
+        .map(|()| status)
+        .map_err(|e| ShmError::ipc("read a status from", service, e.to_string()))
 }
 
 /// Waits up to `timeout` for the server's answer to a sent request.

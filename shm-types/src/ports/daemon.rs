@@ -9,8 +9,8 @@ use iceoryx2::prelude::*;
 use super::stream::{StreamReceiver, StreamSender};
 use crate::services::{self, Access, ControlService, IpcNode, PubSub, SubmitService};
 use crate::{
-    ControlCommand, ControlReply, ControlRequest, DaemonStatus, JointCommand, SensorSample,
-    ServiceNames, ShmError, SubmitReply,
+    ControlCommand, ControlReply, ControlRequest, DaemonStatus, DecodeError, JointCommand,
+    SensorSample, ServiceNames, ShmError, SubmitReply,
 };
 
 /// The control thread's ports: sensor samples in, joint commands out. All operations are
@@ -40,6 +40,12 @@ impl DaemonLoopPorts {
     /// Copies the newest sample into `out`; false when none arrived since the last call.
     pub fn take_latest_sample(&self, out: &mut SensorSample) -> Result<bool, ShmError> {
         self.sensors.take_latest(out)
+    }
+
+    /// How many processes publish on `sensors` (more than one: two adapters' samples would
+    /// interleave). Reads a counter in shared memory; no allocation.
+    pub fn sensor_publishers(&self) -> usize {
+        self.sensors.publishers()
     }
 
     /// Writes a command in place, stamps its send time and wakes the adapter.
@@ -134,11 +140,12 @@ impl DaemonServicePorts {
         Ok(true)
     }
 
-    /// Answers at most one pending control request with `handle(command)`; returns whether
-    /// there was one.
+    /// Answers at most one pending control request with `handle(command)`, where `command` is
+    /// the decoded command or why its code means none (refuse it with that reason); returns
+    /// whether there was a request.
     pub fn serve_control(
         &self,
-        handle: impl FnOnce(ControlCommand) -> ControlReply,
+        handle: impl FnOnce(Result<ControlCommand, DecodeError>) -> ControlReply,
     ) -> Result<bool, ShmError> {
         let Some(request) = self
             .control
@@ -147,7 +154,7 @@ impl DaemonServicePorts {
         else {
             return Ok(false);
         };
-        let reply = handle(request.payload().command);
+        let reply = handle(request.payload().command.get());
         request
             .send_copy(reply)
             .map_err(|e| ShmError::ipc("reply on", &self.control_name, e))?;

@@ -70,7 +70,7 @@ pub(crate) struct StreamReceiver<T: StreamPayload> {
     service_name: String,
     subscriber: Subscriber<ipc::Service, T, ()>,
     listener: Listener<ipc::Service>,
-    _service: PubSub<T>,
+    service: PubSub<T>,
     _event: Event,
 }
 
@@ -92,9 +92,14 @@ impl<T: StreamPayload> StreamReceiver<T> {
             service_name,
             subscriber,
             listener,
-            _service: service,
+            service,
             _event: event,
         })
+    }
+
+    /// How many publishers the stream has now.
+    pub(crate) fn publishers(&self) -> usize {
+        self.service.dynamic_config().number_of_publishers()
     }
 
     /// Blocks until a message is announced or `timeout` passes; returns whether one was

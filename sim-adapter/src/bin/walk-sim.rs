@@ -16,6 +16,7 @@ use std::time::Duration;
 
 use clap::{Parser, ValueEnum};
 use kinematic_sim::SafetySummary;
+use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::process::{exit_code, install_termination_handler, termination_requested};
 use shm_types::{
@@ -79,8 +80,9 @@ fn main() -> ExitCode {
 
 fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
     let config_error = |e: anyhow::Error| (exit_code::CONFIG, e);
-    let mut runtime =
-        RuntimeConfig::from_config_file(&args.config).map_err(|e| config_error(e.into()))?;
+    let file = ConfigFile::load(&args.config).map_err(|e| config_error(e.into()))?;
+    let mut runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())
+        .map_err(|e| config_error(e.into()))?;
     if let Some(rate) = args.rate_hz {
         runtime.rate_hz = rate;
     }
@@ -94,7 +96,7 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
         )));
     }
     let robot =
-        Robot::load(&args.config, args.urdf.as_deref()).map_err(|e| config_error(e.into()))?;
+        Robot::from_config(&file, args.urdf.as_deref()).map_err(|e| config_error(e.into()))?;
     let robot = Arc::new(robot);
     match args.physics {
         Physics::Kinematic => {

@@ -69,6 +69,6 @@ impl GroundTruth for MujocoRobot {
         out.right_foot = pose_array(&sim.end_effector_pose(EndEffector::RightFoot));
         out.base_height_m = sim.base_height();
         out.tilt_rad = sim.torso_tilt();
-        out.fallen = sim.summary().fell;
+        out.fallen = sim.summary().fell.into();
     }
 }

@@ -108,15 +108,17 @@ pub enum GenerateError {
     #[error("railing availability {0:?}: must be finite with from ≤ to")]
     InvalidRailing([f64; 2]),
     /// The robot's IK refused a stance's targets.
-    #[error("stance {stance}: retargeting failed: {source}")]
-    Ik {
-        stance: usize,
-        #[source]
-        source: IkError,
-    },
+    #[error("stance {stance}: retargeting failed: {error}")]
+    Ik { stance: usize, error: IkError },
     /// The generated sequence failed validation (a bug).
     #[error("generated sequence is invalid: {0}")]
-    Invalid(#[from] FormatError),
+    Invalid(FormatError),
+}
+
+impl From<FormatError> for GenerateError {
+    fn from(error: FormatError) -> Self {
+        Self::Invalid(error)
+    }
 }
 
 /// Generates a raw, impeded stance sequence for `robot`; a railing (if the affordance set has
@@ -210,7 +212,7 @@ fn retarget(
         initial.base = initial_base(&robot.standing, body, planned);
         let solved = ik
             .solve(&planned.targets, planned.contacts, &initial)
-            .map_err(|source| GenerateError::Ik { stance: i, source })?;
+            .map_err(|error| GenerateError::Ik { stance: i, error })?;
         stances.push(solved.stance);
     }
     Ok(stances)

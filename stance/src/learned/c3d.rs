@@ -80,9 +80,9 @@ impl Bytes<'_> {
 impl C3dFile {
     /// Reads and parses a C3D file.
     pub fn read(path: &Path) -> Result<Self, LearnError> {
-        let data = std::fs::read(path).map_err(|source| LearnError::Io {
+        let data = std::fs::read(path).map_err(|error| LearnError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         })?;
         Self::parse(&data, path)
     }

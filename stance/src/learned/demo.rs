@@ -98,9 +98,9 @@ struct Manifest {
 /// Loads every trial listed in `dir/demo.toml`.
 pub fn load_folder(dir: &Path) -> Result<Vec<Demonstration>, LearnError> {
     let path = dir.join("demo.toml");
-    let text = std::fs::read_to_string(&path).map_err(|source| LearnError::Io {
+    let text = std::fs::read_to_string(&path).map_err(|error| LearnError::Io {
         path: path.clone(),
-        source,
+        error,
     })?;
     let manifest: Manifest = toml::from_str(&text).map_err(|e| LearnError::Manifest {
         path: path.clone(),
@@ -379,9 +379,9 @@ const GAITKIT_LANDMARKS: [&str; 6] = [
 ];
 
 fn from_gaitkit(path: &Path, axes: &Axes) -> Result<Demonstration, LearnError> {
-    let text = std::fs::read_to_string(path).map_err(|source| LearnError::Io {
+    let text = std::fs::read_to_string(path).map_err(|error| LearnError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let file: GaitkitFile = serde_json::from_str(&text)
         .map_err(|e| LearnError::corrupt(path, format!("gaitkit JSON: {e}")))?;

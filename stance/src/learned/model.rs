@@ -185,9 +185,9 @@ impl NgramModel {
 
     /// Reads and checks a model file.
     pub fn from_path(path: &Path) -> Result<Self, LearnError> {
-        let text = std::fs::read_to_string(path).map_err(|source| LearnError::Io {
+        let text = std::fs::read_to_string(path).map_err(|error| LearnError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         })?;
         Self::from_json_str(&text, path)
     }

@@ -16,9 +16,9 @@ pub struct NpyArray {
 
 /// Reads a `.npy` file.
 pub fn read(path: &Path) -> Result<NpyArray, LearnError> {
-    let bytes = std::fs::read(path).map_err(|source| LearnError::Io {
+    let bytes = std::fs::read(path).map_err(|error| LearnError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     parse(&bytes, path)
 }
