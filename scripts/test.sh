@@ -13,5 +13,7 @@ mujoco_env="$(scripts/setup-mujoco.sh)"
 eval "$mujoco_env"
 
 cargo build --release --workspace --bins --features sim-adapter/mujoco
-# walk-tests/mujoco: the in-process physics walk (tests/physics_walk.rs fails if it is off).
-cargo test --release --workspace --features sim-adapter/mujoco,walk-tests/mujoco "$@"
+# The adapter example of docs/adapter.md, run by the e2e tests.
+cargo build --release -p sim-adapter --examples --features sim-adapter/mujoco
+# walk-bench/mujoco: the in-process physics walk (bench/tests/physics_walk.rs fails if it is off).
+cargo test --release --workspace --features sim-adapter/mujoco,walk-bench/mujoco "$@"

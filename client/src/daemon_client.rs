@@ -6,9 +6,11 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, bail};
 use kinematics::ConfigFile;
 use shm_types::{
-    ClientPorts, ControlCommand, DaemonState, DaemonStatus, LatencySummary, RuntimeConfig,
-    ServiceNames, ShmError,
+    ClientPorts, ControlCommand, DaemonState, DaemonStatus, LatencySummary, LinkState,
+    RuntimeConfig, ServiceNames, ShmError,
 };
+
+use crate::process::Process;
 
 /// How long a request to the daemon may take before it counts as unanswered.
 pub const REQUEST_TIMEOUT: Duration = Duration::from_secs(10);
@@ -140,6 +142,34 @@ impl DaemonClient {
                 );
             }
         }
+    }
+}
+
+/// Waits until the daemon on `prefix` serves with a fresh adapter link, failing with a child's
+/// log as soon as one of `watched` (the processes started for it, if any) exits.
+pub fn connect_when_fresh(
+    prefix: &str,
+    watched: &[Process],
+    timeout: Duration,
+) -> anyhow::Result<DaemonClient> {
+    let start = Instant::now();
+    loop {
+        for process in watched {
+            process.check_running()?;
+        }
+        if let Ok(client) = DaemonClient::connect(prefix)
+            && let Ok(status) = client.status()
+            && status.link == LinkState::Fresh
+        {
+            return Ok(client);
+        }
+        if start.elapsed() > timeout {
+            bail!(
+                "walkd on `{prefix}` did not get fresh samples within {} s",
+                timeout.as_secs()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
     }
 }
 

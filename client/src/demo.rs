@@ -6,18 +6,20 @@
 //! down with SIGTERM. The simulator's ground truth (`sim-truth`) is recorded meanwhile, so a walk
 //! the daemon finished with the simulated robot on the floor is reported as a fall.
 
-use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use kinematics::ConfigFile;
 use kinematics::robot::Robot;
+use shm_types::process::Physics;
 use shm_types::{ClockMode, DaemonState, DaemonStatus, LatencySummary, RuntimeConfig};
+use stance::WalkRequest;
 
+use crate::daemon_client::connect_when_fresh;
 use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
-use crate::evaluate::process::{Process, connect_when_fresh};
 use crate::evaluate::truth::{TruthRecorder, Verdict, judged_outcome};
+use crate::process::{Launch, Processes, executable_dir};
 use crate::watch::StanceProgress;
 
 /// The robots with a vendored config.
@@ -41,26 +43,6 @@ impl DemoRobot {
     }
 }
 
-/// Simulator backends `walk-sim` offers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum DemoPhysics {
-    /// The deterministic kinematic simulator.
-    Kinematic,
-    /// MuJoCo rigid-body dynamics with contacts (walk-sim built with --features
-    /// sim-adapter/mujoco after scripts/setup-mujoco.sh).
-    Mujoco,
-}
-
-impl DemoPhysics {
-    /// The `walk-sim --physics` value.
-    fn name(self) -> &'static str {
-        match self {
-            Self::Kinematic => "kinematic",
-            Self::Mujoco => "mujoco",
-        }
-    }
-}
-
 /// Arguments of `walkctl demo`.
 #[derive(Debug, clap::Args)]
 pub struct DemoArgs {
@@ -70,9 +52,9 @@ pub struct DemoArgs {
     /// Distance to walk forward (m).
     #[arg(long, default_value_t = 1.0)]
     pub distance: f64,
-    /// Simulator backend of the started `walk-sim`.
-    #[arg(long, value_enum, default_value = "kinematic")]
-    pub physics: DemoPhysics,
+    /// Simulator of the started `walk-sim`: kinematic or mujoco.
+    #[arg(long, default_value = "kinematic")]
+    pub physics: Physics,
     /// Clock of the started processes: realtime (at the config's rate) or lockstep (fast).
     #[arg(long, default_value = "realtime")]
     pub clock: ClockMode,
@@ -160,7 +142,7 @@ impl DemoOutcome {
 fn default_config(robot: DemoRobot) -> anyhow::Result<PathBuf> {
     let file = format!("{}.toml", robot.name());
     let mut candidates = vec![Path::new("configs").join(&file)];
-    if let Some(dir) = executable_dir() {
+    if let Ok(dir) = executable_dir() {
         candidates.push(dir.join("../../configs").join(&file));
     }
     candidates
@@ -175,50 +157,16 @@ fn default_config(robot: DemoRobot) -> anyhow::Result<PathBuf> {
         })
 }
 
-fn executable_dir() -> Option<PathBuf> {
-    std::env::current_exe().ok()?.parent().map(Path::to_owned)
-}
-
-/// Child processes started by the demo, oldest first; stopped with SIGTERM when dropped.
-struct Children(Vec<Process>);
-
-impl Children {
-    /// SIGTERM to each child (newest first), waiting up to 5 s each, then SIGKILL; returns what
-    /// went wrong.
-    fn shut_down(&mut self) -> anyhow::Result<Vec<String>> {
-        let mut problems = Vec::new();
-        while let Some(child) = self.0.pop() {
-            problems.extend(child.stop()?.problem);
-        }
-        Ok(problems)
-    }
-}
-
-impl Drop for Children {
-    fn drop(&mut self) {
-        // On an error path: stop them gracefully; the error being returned matters more.
-        let _ = self.shut_down();
-    }
-}
-
-/// Generates and post-processes a forward walk of `distance` for `robot` (config `config`);
-/// returns the sequence's JSON and its number of stances.
+/// A forward walk of `distance` on the feet for `robot`, post-processed with the config's
+/// `[postprocess]`: the sequence's JSON and its number of stances.
 pub fn walk_sequence(
     robot: &Robot,
-    config: &Path,
+    file: &ConfigFile,
     distance: f64,
     seed: u64,
 ) -> anyhow::Result<(String, usize)> {
-    let params = stance::PostProcessParams::from_config_path(config)?;
-    let raw = stance::generate(
-        robot,
-        &stance::GenerateOptions {
-            distance: distance / params.scf,
-            affordances: stance::AffordanceSet::Feet,
-            seed,
-        },
-    )?;
-    let processed = stance::PostProcessor::new(robot, params).process(&raw)?;
+    let params = stance::PostProcessParams::from_config(file)?;
+    let processed = stance::synthetic_walk(robot, &params, &WalkRequest::feet(distance, seed))?;
     Ok((processed.to_json_string(), processed.len()))
 }
 
@@ -235,32 +183,23 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         .clone()
         .unwrap_or(runtime.service_prefix);
     let robot = Robot::from_config(&file, args.urdf.as_deref())?;
-    let (json, stance_count) = walk_sequence(&robot, &config, args.distance, args.seed)?;
+    let (json, stance_count) = walk_sequence(&robot, &file, args.distance, args.seed)?;
 
-    let mut children = Children(Vec::new());
+    let mut children = Processes::default();
     let running = DaemonClient::connect(&prefix).is_ok_and(|client| client.is_running());
     if !running {
-        let mut common: Vec<OsString> = vec![
-            "--config".into(),
-            config.clone().into(),
-            "--service-prefix".into(),
-            prefix.clone().into(),
-            "--clock".into(),
-            args.clock.name().into(),
-        ];
-        if let Some(urdf) = &args.urdf {
-            common.extend(["--urdf".into(), urdf.clone().into()]);
-        }
-        if let Some(rate) = args.rate_hz {
-            common.extend(["--rate-hz".into(), rate.to_string().into()]);
-        }
-        children.0.push(Process::start("walkd", &common)?);
-        let mut sim_args = common;
-        sim_args.extend(["--physics".into(), args.physics.name().into()]);
-        children.0.push(Process::start("walk-sim", &sim_args)?);
+        let launch = Launch {
+            bin_dir: executable_dir()?,
+            config: config.clone(),
+            prefix: prefix.clone(),
+            clock: args.clock,
+            rate_hz: args.rate_hz,
+            urdf: args.urdf.clone(),
+        };
+        children.0.push(launch.walkd(&[], &[])?);
+        children.0.push(launch.walk_sim(args.physics)?);
     }
-    let processes: Vec<&Process> = children.0.iter().collect();
-    let client = connect_when_fresh(&prefix, &processes, Duration::from_secs(20))?;
+    let client = connect_when_fresh(&prefix, &children.0, Duration::from_secs(20))?;
     let recorder = TruthRecorder::start(&prefix)?;
     let start = client.status()?;
     let wall = Instant::now();

@@ -15,43 +15,25 @@
 //! only): target vs controller state vs simulator over time for the CoM and both feet
 //! ([`write_fig6`] is shared with the in-process physics walk of the `walk-tests` package).
 
-pub(crate) mod process;
 pub(crate) mod truth;
 
-use std::ffi::OsString;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
+use kinematics::ground::sequence_alignment;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use plotters::prelude::*;
-use shm_types::{DaemonState, DaemonStatus, SimTruth};
-use stance::geometry::sequence_alignment;
+use shm_types::process::Physics;
+use shm_types::{ClockMode, DaemonState, DaemonStatus, SimTruth};
 use stance::poses::FEET;
-use stance::{AffordanceSet, PostProcessedSequence};
+use stance::{AffordanceSet, PostProcessedSequence, WalkRequest};
 
-use process::{Process, connect_when_fresh};
-
-/// Simulator backends `walk-sim` offers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum EvaluatePhysics {
-    /// Rigid-body dynamics with contacts (the paper's Bullet role).
-    Mujoco,
-    /// The deterministic kinematic simulator.
-    Kinematic,
-}
-
-impl EvaluatePhysics {
-    fn name(self) -> &'static str {
-        match self {
-            Self::Mujoco => "mujoco",
-            Self::Kinematic => "kinematic",
-        }
-    }
-}
+use crate::daemon_client::connect_when_fresh;
+use crate::process::{Launch, executable_dir};
 
 /// Arguments of `walkctl evaluate`.
 #[derive(Debug, clap::Args)]
@@ -72,9 +54,9 @@ pub struct EvaluateArgs {
     /// Runs per robot, affordance set and distance (run i uses generator seed i).
     #[arg(long, default_value_t = 10)]
     pub runs: u32,
-    /// Simulator backend of `walk-sim`.
-    #[arg(long, value_enum, default_value = "mujoco")]
-    pub physics: EvaluatePhysics,
+    /// Simulator of `walk-sim`: mujoco or kinematic.
+    #[arg(long, default_value = "mujoco")]
+    pub physics: Physics,
     /// Directory with the robot configs (`<robot>.toml`).
     #[arg(long, default_value = "configs")]
     pub config_dir: PathBuf,
@@ -334,35 +316,27 @@ fn run_once(
     run: u32,
 ) -> anyhow::Result<RunResult> {
     let params = stance::PostProcessParams::from_config_path(config)?;
-    let raw = stance::generate(
-        model,
-        &stance::GenerateOptions {
-            distance: distance / params.scf,
-            affordances,
-            seed: u64::from(run),
-        },
-    )?;
-    let sequence = stance::PostProcessor::new(model, params).process(&raw)?;
+    let request = WalkRequest {
+        distance,
+        affordances,
+        seed: u64::from(run),
+    };
+    let sequence = stance::synthetic_walk(model, &params, &request)?;
     let mut targets = stance_points(model, &sequence);
     let prefix = format!("walk-eval/{robot}/{}/{run}", std::process::id());
-    let mut common: Vec<OsString> = vec![
-        "--config".into(),
-        config.into(),
-        "--service-prefix".into(),
-        prefix.clone().into(),
-        "--clock".into(),
-        "lockstep".into(),
+    let launch = Launch {
+        bin_dir: executable_dir()?,
+        config: config.to_owned(),
+        prefix: prefix.clone(),
+        clock: ClockMode::Lockstep,
+        rate_hz: None,
+        urdf: args.urdf.clone(),
+    };
+    let processes = [
+        launch.walkd(&["--no-lock-memory"], &[])?,
+        launch.walk_sim(args.physics)?,
     ];
-    if let Some(urdf) = &args.urdf {
-        common.extend(["--urdf".into(), urdf.into()]);
-    }
-    let mut walkd_args = common.clone();
-    walkd_args.push("--no-lock-memory".into());
-    let walkd = Process::start("walkd", &walkd_args)?;
-    let mut sim_args = common;
-    sim_args.extend(["--physics".into(), args.physics.name().into()]);
-    let sim = Process::start("walk-sim", &sim_args)?;
-    let client = connect_when_fresh(&prefix, &[&walkd, &sim], Duration::from_secs(30))?;
+    let client = connect_when_fresh(&prefix, &processes, Duration::from_secs(30))?;
     let recorder = truth::TruthRecorder::start(&prefix)?;
     let start = client.status()?;
     align_targets(
@@ -385,6 +359,7 @@ fn run_once(
     let wall_s = wall.elapsed().as_secs_f64();
     drop(client);
     let states = recorder.finish()?;
+    let [walkd, sim] = processes;
     let walkd_log = walkd.stop()?.log;
     let sim_log = sim.stop()?.log;
     let Some(verdict) = truth::Verdict::of(&states, submitted_ns) else {

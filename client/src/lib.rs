@@ -1,7 +1,9 @@
 //! `walkctl` as a library: the operations on robot models, stance sequences and a running `walkd`.
 //!
 //! One module per subcommand; each exposes its `clap::Args` struct and a `run` function so the
-//! binary only dispatches and programs can call the same operations.
+//! binary only dispatches and programs can call the same operations. [`daemon_client`] is the
+//! library API to a running walkd, [`process`] the one way to start and stop the system's
+//! processes (walkctl, the latency report and the end-to-end tests use it).
 
 pub mod bench_coverage;
 pub mod bench_postprocess;
@@ -13,6 +15,7 @@ pub mod generate;
 pub mod inspect;
 pub mod learn;
 pub mod postprocess;
+pub mod process;
 pub mod status;
 pub mod submit;
 pub mod watch;

@@ -2,10 +2,11 @@
 //!
 //! - [`qp`]: the QP problem form and its solvers (clarabel reference, dense active set).
 //! - [`controller`]: the controller core (tasks, constraints, state machine); no IPC, clocks or files.
-//! - [`bench`]: `walkd bench`, an in-process walk against the kinematic simulator.
 //! - [`runtime`]: the daemon process (fixed-rate loop, IPC, signals, systemd).
+//!
+//! The daemon links no simulator, client or adapter: closed-loop walks against a simulator, the
+//! benchmarks and the latency report live in the `walk-bench` crate.
 
-pub mod bench;
 pub mod controller;
 pub mod qp;
 pub mod runtime;

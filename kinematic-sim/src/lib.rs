@@ -17,19 +17,21 @@
 //!   each FT frame origin in world-aligned axes (the force the ground exerts on the robot).
 //! - **Safety metrics**: stability margin (signed distance of the CoM ground projection to the
 //!   support polygon; negative = fall), contact slip, penetration, joint limit violations.
+//!
+//! [`Simulator`] is the interface every simulated robot offers (this one and MuJoCo's), so one
+//! closed loop and one adapter wrapper serve both.
 
-pub mod support;
+mod simulator;
+
+pub use simulator::Simulator;
 
 use std::sync::Arc;
 
 use kinematics::configuration::Configuration;
+use kinematics::ground::{GRAVITY, SupportPolygon, sole_corners};
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
-use support::{SupportPolygon, sole_corners};
-
-/// Standard gravity used for the synthetic force readings (m/s²).
-pub const GRAVITY: f64 = 9.81;
 
 const FEET: [EndEffector; 2] = [EndEffector::LeftFoot, EndEffector::RightFoot];
 
@@ -241,6 +243,8 @@ pub struct KinematicSim {
     measurement: SimMeasurement,
     summary: SafetySummary,
     corners: [[f64; 2]; 8],
+    /// Simulated time since the start (s).
+    time: f64,
 }
 
 impl KinematicSim {
@@ -277,6 +281,7 @@ impl KinematicSim {
             measurement,
             summary: SafetySummary::default(),
             corners: [[0.0; 2]; 8],
+            time: 0.0,
         };
         let mut lowest = f64::INFINITY;
         for (slot, foot) in FEET.iter().enumerate() {
@@ -293,49 +298,9 @@ impl KinematicSim {
         Ok(sim)
     }
 
-    /// The robot being simulated.
-    pub fn robot(&self) -> &Arc<Robot> {
-        &self.robot
-    }
-
-    /// The current sensor readings, ground truth and safety metrics.
-    pub fn measurement(&self) -> &SimMeasurement {
-        &self.measurement
-    }
-
-    /// Worst safety values since the start.
-    pub fn summary(&self) -> &SafetySummary {
-        &self.summary
-    }
-
     /// The full configuration (ground truth base and joints).
     pub fn configuration(&self) -> &Configuration {
         &self.configuration
-    }
-
-    /// Advances by `dt`: joints move to `q_des` (ideal servo, stopped at the limits), the base
-    /// follows the feet in contact, contacts, forces and metrics are updated. `qd_des` is checked
-    /// but not needed by the ideal servo.
-    pub fn step(&mut self, q_des: &[f64], qd_des: &[f64], dt: f64) -> Result<(), SimError> {
-        self.check_command("q_des", q_des)?;
-        self.check_command("qd_des", qd_des)?;
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(SimError::BadTimeStep(dt));
-        }
-        let mut violations = 0;
-        let limits = self.robot.model.joint_limits();
-        for (j, (&target, limit)) in q_des.iter().zip(limits).enumerate() {
-            let q = target.clamp(limit.lower, limit.upper);
-            if q != target {
-                violations += 1;
-            }
-            self.measurement.qd[j] = (q - self.configuration.joints[j]) / dt;
-            self.configuration.joints[j] = q;
-        }
-        self.place_base();
-        self.update_contacts();
-        self.finish_step(violations);
-        Ok(())
     }
 
     fn check_command(&self, field: &'static str, values: &[f64]) -> Result<(), SimError> {

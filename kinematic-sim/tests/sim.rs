@@ -1,9 +1,11 @@
 //! Behaviour of the kinematic simulator on the vendored robots.
 
+use kinematic_sim::Simulator;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use kinematic_sim::{GRAVITY, KinematicSim, SimError};
+use kinematic_sim::{KinematicSim, SimError};
+use kinematics::ground::GRAVITY;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 

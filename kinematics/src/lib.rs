@@ -14,6 +14,7 @@
 
 pub mod config_file;
 pub mod configuration;
+pub mod ground;
 pub mod ik;
 pub mod kinematics;
 pub mod model;

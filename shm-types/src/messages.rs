@@ -177,21 +177,6 @@ wire_enum! {
     }
 }
 
-impl core::str::FromStr for ClockMode {
-    type Err = String;
-
-    /// Parses `realtime` or `lockstep` (the `--clock` option of walkd and the adapters).
-    fn from_str(text: &str) -> Result<Self, String> {
-        match text {
-            "realtime" => Ok(Self::Realtime),
-            "lockstep" => Ok(Self::Lockstep),
-            other => Err(format!(
-                "unknown clock `{other}` (expected realtime or lockstep)"
-            )),
-        }
-    }
-}
-
 wire_enum! {
     /// Health of the link to the adapter as the daemon's watchdog sees it.
     pub enum LinkState {

@@ -1,6 +1,9 @@
-//! What every process of the system does the same way: exit codes and termination requests.
+//! What every process of the system does the same way: exit codes, termination requests, and
+//! the names of the simulators `walk-sim` runs (so the clients that start it pass the same).
 
 use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::wire::wire_enum;
 
 /// Exit codes shared by `walkd` and the adapters (documented in docs/ipc.md).
 pub mod exit_code {
@@ -41,4 +44,14 @@ pub fn install_termination_handler() {
 /// Whether SIGTERM or SIGINT arrived since [`install_termination_handler`].
 pub fn termination_requested() -> bool {
     TERMINATION_REQUESTED.load(Ordering::SeqCst)
+}
+
+wire_enum! {
+    /// The simulator behind `walk-sim --physics`, named the same by every process that starts it.
+    pub enum Physics {
+        /// The deterministic kinematic simulator (ideal servos, feet anchored in contact).
+        Kinematic = 0 => "kinematic",
+        /// MuJoCo rigid-body dynamics with contacts (walk-sim built with the `mujoco` feature).
+        Mujoco = 1 => "mujoco",
+    }
 }

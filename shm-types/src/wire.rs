@@ -200,8 +200,8 @@ impl From<bool> for Flag {
     }
 }
 
-/// Declares a C-like enum that travels as a [`Code`]: its variants with their codes and
-/// lower-case names, and the [`WireEnum`] implementation.
+/// Declares a C-like enum with codes and lower-case names: the [`WireEnum`] implementation (so
+/// it can travel as a [`Code`]), `name()`, and `FromStr` from the names (for command lines).
 macro_rules! wire_enum {
     (
         $(#[$meta:meta])*
@@ -244,6 +244,22 @@ macro_rules! wire_enum {
                 $crate::wire::WireEnum::name(self)
             }
         }
+
+        impl core::str::FromStr for $name {
+            type Err = String;
+
+            /// Parses a lower-case name.
+            fn from_str(text: &str) -> Result<Self, String> {
+                match text {
+                    $( $text => Ok(Self::$variant), )+
+                    other => Err(format!(
+                        concat!("unknown ", stringify!($name), " `{}` (expected ",
+                            $( $text, " ", )+ ")"),
+                        other
+                    )),
+                }
+            }
+        }
     };
 }
 
@@ -277,6 +293,8 @@ mod tests {
         assert!(Code::<Mode>::from_raw(257) != Mode::Hold);
         assert_eq!(Code::<Mode>::from_raw(9).name(), "invalid");
         assert_eq!(Mode::Track.name(), "track");
+        assert_eq!("hold".parse(), Ok(Mode::Hold));
+        assert!("halt".parse::<Mode>().unwrap_err().contains("halt"));
     }
 
     #[test]

@@ -7,6 +7,7 @@
 //! 1 ms physics step (median and 99th percentile of the calls, divided by the substeps) and the real-time
 //! factor of the whole run.
 
+use kinematic_sim::Simulator;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;

@@ -4,13 +4,14 @@
 //!   A hardware adapter (ARMAR-4, HRP-4) implements only this (see docs/adapter.md).
 //! - [`run_adapter`]: the adapter loop shared by every robot: publishes samples through
 //!   [`shm_types::AdapterPorts`], applies commands, and holds position when commands go stale.
-//! - [`KinematicRobot`]: [`RobotIo`] over the kinematic simulator (`--physics kinematic`).
+//! - [`SimulatedRobot`]: [`RobotIo`] over any [`kinematic_sim::Simulator`] (the kinematic
+//!   simulator, `--physics kinematic`, or MuJoCo, `--physics mujoco`).
 //! - [`GroundTruth`], [`PublishTruth`]: a simulated robot's true state on the `sim-truth`
 //!   service, for evaluation (drift of the controller's estimate, fall judgement).
 
 mod adapter_loop;
-mod kinematic;
 mod robot_io;
+mod simulated;
 mod truth;
 
 /// The MuJoCo physics backend (feature `mujoco`; library from scripts/setup-mujoco.sh).
@@ -18,6 +19,6 @@ mod truth;
 pub mod mujoco;
 
 pub use adapter_loop::{AdapterError, AdapterOptions, AdapterReport, run_adapter};
-pub use kinematic::KinematicRobot;
 pub use robot_io::RobotIo;
+pub use simulated::SimulatedRobot;
 pub use truth::{GroundTruth, PublishTruth};

@@ -1,6 +1,5 @@
 //! The robot-facing side of an adapter.
 
-use kinematic_sim::SimMeasurement;
 use shm_types::SensorSample;
 
 /// A robot as an adapter sees it: sensors to read and joints to command, in the model's joint
@@ -24,17 +23,4 @@ pub trait RobotIo {
 
     /// Applies one period's setpoint (`dt` seconds; a simulator advances by it).
     fn write(&mut self, q_des: &[f64], qd_des: &[f64], dt: f64) -> Result<(), Self::Error>;
-}
-
-/// Copies a simulator's sensor readings into `sample`: joint angles and velocities, the four
-/// wrenches and the base orientation as an ideal IMU (`[x, y, z, w]`). Shared by every simulated
-/// robot, since both simulators report the same [`SimMeasurement`] record. No allocation.
-pub(crate) fn fill_sample(measurement: &SimMeasurement, sample: &mut SensorSample) {
-    let n = measurement.q.len();
-    sample.q[..n].copy_from_slice(measurement.q.as_slice());
-    sample.qd[..n].copy_from_slice(measurement.qd.as_slice());
-    sample.wrenches = measurement.wrenches;
-    let q = measurement.base_orientation.quaternion();
-    sample.imu_orientation = [q.i, q.j, q.k, q.w];
-    sample.has_imu = true.into();
 }

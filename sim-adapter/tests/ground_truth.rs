@@ -1,12 +1,14 @@
 //! The simulator's ground truth: what each simulated robot reports, and its publication on
 //! `sim-truth` next to every sensor reading.
 
+use kinematic_sim::Simulator;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use kinematic_sim::KinematicSim;
 use kinematics::robot::Robot;
 use shm_types::{SensorSample, ServiceNames, SimTruth, TruthPublisher, TruthSubscriber};
-use sim_adapter::{GroundTruth, KinematicRobot, PublishTruth, RobotIo};
+use sim_adapter::{GroundTruth, PublishTruth, RobotIo, SimulatedRobot};
 
 const DT: f64 = 0.002;
 
@@ -39,7 +41,9 @@ fn assert_standing(name: &str, truth: &SimTruth) {
 
 #[test]
 fn the_kinematic_robot_reports_its_simulated_state() {
-    let mut sim = KinematicRobot::standing(robot("jvrc1")).unwrap();
+    let robot = robot("jvrc1");
+    let standing = robot.standing.clone();
+    let mut sim = SimulatedRobot::new(KinematicSim::new(robot, standing).unwrap());
     let mut truth = SimTruth::ZERO;
     sim.ground_truth(&mut truth);
     assert_standing("jvrc1", &truth);
@@ -53,8 +57,9 @@ fn every_reading_publishes_the_truth_with_its_time() {
     let robot = robot("armar4");
     let q: Vec<f64> = robot.standing.joints.iter().copied().collect();
     let qd = vec![0.0; q.len()];
+    let standing = robot.standing.clone();
     let mut sim = PublishTruth::new(
-        KinematicRobot::standing(robot).unwrap(),
+        SimulatedRobot::new(KinematicSim::new(robot, standing).unwrap()),
         TruthPublisher::open(&names, "simulator").unwrap(),
     );
     let mut sample = SensorSample::ZERO;
@@ -75,7 +80,7 @@ fn every_reading_publishes_the_truth_with_its_time() {
     assert!(received[1].timestamp_ns <= shm_types::monotonic_ns());
     assert_standing("armar4", &received[1]);
     // The reading itself is the robot's, untouched by the wrapper.
-    let measured = sim.robot().summary();
+    let measured = sim.robot().sim().summary();
     assert!(!measured.fell);
     assert_eq!(sample.q[..q.len()], q[..]);
 }
@@ -84,13 +89,15 @@ fn every_reading_publishes_the_truth_with_its_time() {
 #[test]
 fn the_mujoco_robot_reports_its_physics_state() {
     use kinematics::robot::EndEffector;
-    use sim_adapter::mujoco::{MujocoOptions, MujocoRobot};
+    use sim_adapter::mujoco::{MujocoOptions, MujocoSim};
 
     let robot = robot("jvrc1");
-    let urdf = robot.urdf.clone();
+    let (urdf, standing) = (robot.urdf.clone(), robot.standing.clone());
     let q: Vec<f64> = robot.standing.joints.iter().copied().collect();
     let qd = vec![0.0; q.len()];
-    let mut io = MujocoRobot::standing(robot, &urdf, MujocoOptions::default()).unwrap();
+    let mut io = SimulatedRobot::new(
+        MujocoSim::new(robot, &urdf, &standing, MujocoOptions::default()).unwrap(),
+    );
     for _ in 0..100 {
         io.write(&q, &qd, DT).unwrap();
     }

@@ -3,6 +3,7 @@
 //! Needs the `mujoco` feature (and the library: `eval "$(scripts/setup-mujoco.sh)"`).
 #![cfg(feature = "mujoco")]
 
+use kinematic_sim::Simulator;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -14,7 +15,8 @@ use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Vector2};
 use shm_types::SensorSample;
 use sim_adapter::RobotIo;
-use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoRobot, MujocoSim};
+use sim_adapter::SimulatedRobot;
+use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim};
 
 /// Control period the daemon runs at by default (500 Hz): two physics steps per call.
 const DT: f64 = 0.002;
@@ -497,8 +499,15 @@ fn jvrc1_balances_on_one_foot() {
 #[test]
 fn the_adapter_side_reads_what_the_simulator_measures() {
     let (robot, urdf) = robot("jvrc1");
-    let mut io = MujocoRobot::standing(robot.clone(), &urdf, MujocoOptions::default())
-        .expect("model builds");
+    let mut io = SimulatedRobot::new(
+        MujocoSim::new(
+            robot.clone(),
+            &urdf,
+            &robot.standing,
+            MujocoOptions::default(),
+        )
+        .expect("model builds"),
+    );
     let n = io.joint_count();
     assert_eq!(n, robot.model.dof());
     let q = robot.standing.joints.as_slice().to_vec();

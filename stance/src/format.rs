@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use crate::environment::{Environment, HandAffordance, SupportSurface};
 use crate::error::{FormatError, Location};
 use crate::json_path::{location_at, offset_of};
-use crate::sequence::{PostProcessedSequence, RawSequence, Stance};
+use crate::sequence::{PostProcessedSequence, RawSequence, Stance, StanceSequence};
 
 /// The file format version this build writes and reads.
 pub const FORMAT_VERSION: u32 = 1;
@@ -270,6 +270,36 @@ pub fn count_stances(text: &str) -> Result<usize, FormatError> {
         .map_err(|error| json_error(text, error))
 }
 
+/// `sequence` if it is for `robot` (name, joint names and order).
+fn for_robot<S: std::ops::Deref<Target = StanceSequence>>(
+    sequence: S,
+    robot: &Robot,
+) -> Result<S, FormatError> {
+    sequence.check_robot(robot)?;
+    Ok(sequence)
+}
+
+/// The file form of `sequence`, with the targets of stance `i` from `targets(i)`.
+fn file_dto<'a>(
+    sequence: &StanceSequence,
+    kind: Kind,
+    targets: impl Fn(usize) -> Option<&'a [Isometry3<f64>; 4]>,
+) -> FileDto {
+    FileDto {
+        format_version: FORMAT_VERSION.into(),
+        kind,
+        robot: sequence.robot.clone(),
+        joint_names: sequence.joint_names.clone(),
+        environment: (&sequence.environment).into(),
+        stances: sequence
+            .stances
+            .iter()
+            .enumerate()
+            .map(|(i, s)| stance_dto(s, targets(i)))
+            .collect(),
+    }
+}
+
 fn json_error(text: &str, error: serde_json::Error) -> FormatError {
     let (line, column) = (error.line(), error.column());
     let offset = offset_of(text, line, column);
@@ -391,21 +421,12 @@ impl RawSequence {
 
     /// Reads a raw stance file and checks that it is for `robot` (name, joint names and order).
     pub fn from_json_str(text: &str, robot: &Robot) -> Result<Self, FormatError> {
-        let sequence = Self::parse_json_str(text)?;
-        sequence.check_robot(robot)?;
-        Ok(sequence)
+        for_robot(Self::parse_json_str(text)?, robot)
     }
 
     /// The sequence as a (pretty-printed) stance file.
     pub fn to_json_string(&self) -> String {
-        write(&FileDto {
-            format_version: FORMAT_VERSION.into(),
-            kind: Kind::Raw,
-            robot: self.robot.clone(),
-            joint_names: self.joint_names.clone(),
-            environment: (&self.environment).into(),
-            stances: self.stances.iter().map(|s| stance_dto(s, None)).collect(),
-        })
+        write(&file_dto(self, Kind::Raw, |_| None))
     }
 }
 
@@ -433,25 +454,13 @@ impl PostProcessedSequence {
     /// Reads a post-processed stance file and checks that it is for `robot`. This is the
     /// validator a daemon applies to sequences it receives as JSON bytes.
     pub fn from_json_str(text: &str, robot: &Robot) -> Result<Self, FormatError> {
-        let sequence = Self::parse_json_str(text)?;
-        sequence.check_robot(robot)?;
-        Ok(sequence)
+        for_robot(Self::parse_json_str(text)?, robot)
     }
 
     /// The sequence as a (pretty-printed) stance file.
     pub fn to_json_string(&self) -> String {
-        write(&FileDto {
-            format_version: FORMAT_VERSION.into(),
-            kind: Kind::PostProcessed,
-            robot: self.robot.clone(),
-            joint_names: self.joint_names.clone(),
-            environment: (&self.environment).into(),
-            stances: self
-                .stances
-                .iter()
-                .zip(&self.targets)
-                .map(|(s, t)| stance_dto(s, Some(t)))
-                .collect(),
-        })
+        write(&file_dto(self, Kind::PostProcessed, |i| {
+            Some(&self.targets[i])
+        }))
     }
 }

@@ -6,8 +6,11 @@
 //! - [`PoseSequence`]: world poses of root and end-effectors per stance, the passes' working form.
 //! - [`passes`]: the nine passes, each a function; [`PostProcessor`] runs FK + all passes with
 //!   reusable buffers.
-//! - [`generate()`]: a human-like, impeded stance source (until an n-gram generator exists).
+//! - [`generate()`]: a human-like, impeded stance source; `learned` (feature `learned`): the
+//!   n-gram model trained on human demonstrations.
+//! - [`walk`]: a walk of a given distance (generated for `distance / scf`, then post-processed).
 //! - [`derived`]: step sizes, swing heights, orthogonal foot distances.
+//! - `plot` (feature `plot`): SVG figures of sequences.
 //!
 //! Conventions: world z up, metres, radians; quaternions `[x, y, z, w]` in files; end-effector
 //! arrays are indexed by `kinematics::robot::EndEffector as usize`.
@@ -19,14 +22,17 @@ pub mod format;
 pub mod generate;
 pub mod geometry;
 mod json_path;
+#[cfg(feature = "learned")]
 pub mod learned;
 pub mod params;
 pub mod passes;
 mod pipeline;
+#[cfg(feature = "plot")]
 pub mod plot;
 pub mod poses;
 pub mod sequence;
 mod stance_ik;
+pub mod walk;
 
 pub use environment::{Environment, HandAffordance, SupportSurface};
 pub use error::{FormatError, Location};
@@ -37,4 +43,5 @@ pub use geometry::PathFrame;
 pub use params::{ContactUnification, ParamsError, PostProcessParams};
 pub use pipeline::PostProcessor;
 pub use poses::PoseSequence;
-pub use sequence::{PostProcessedSequence, RawSequence, Stance};
+pub use sequence::{PostProcessedSequence, RawSequence, Stance, StanceSequence};
+pub use walk::{WalkRequest, synthetic_walk};

@@ -104,21 +104,22 @@ impl PostProcessedSequence {
     /// Overwrites `self` with `raw`'s stances (same `q_S` and contacts, root translations from the
     /// post-processed roots) and the post-processed end-effector poses, reusing buffers.
     fn assign(&mut self, raw: &RawSequence, poses: &PoseSequence) {
-        if self.robot != raw.robot {
-            self.robot.clone_from(&raw.robot);
+        let sequence = &mut self.sequence;
+        if sequence.robot != raw.robot {
+            sequence.robot.clone_from(&raw.robot);
         }
-        if self.joint_names != raw.joint_names {
-            self.joint_names.clone_from(&raw.joint_names);
+        if sequence.joint_names != raw.joint_names {
+            sequence.joint_names.clone_from(&raw.joint_names);
         }
-        if self.environment != raw.environment {
-            self.environment = raw.environment.clone();
+        if sequence.environment != raw.environment {
+            sequence.environment = raw.environment.clone();
         }
-        self.stances.truncate(raw.stances.len());
+        sequence.stances.truncate(raw.stances.len());
         let mut previous = Vector3::zeros();
         for (i, (stance, root)) in raw.stances.iter().zip(&poses.roots).enumerate() {
             let translation = root.translation.vector - previous;
             previous = root.translation.vector;
-            match self.stances.get_mut(i) {
+            match sequence.stances.get_mut(i) {
                 Some(existing) => {
                     existing.q.clear();
                     existing.q.extend_from_slice(&stance.q);
@@ -126,7 +127,7 @@ impl PostProcessedSequence {
                     existing.translation = translation;
                     existing.root_orientation = stance.root_orientation;
                 }
-                None => self.stances.push(Stance {
+                None => sequence.stances.push(Stance {
                     translation,
                     ..stance.clone()
                 }),

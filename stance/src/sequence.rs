@@ -30,13 +30,20 @@ impl Stance {
     }
 }
 
-/// A sequence as a stance source delivers it, impediments included.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RawSequence {
+/// What both kinds of sequence hold, with its accessors: the robot and joint order it is for, its
+/// environment, and its stances. [`RawSequence`] and [`PostProcessedSequence`] dereference to it.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct StanceSequence {
     pub(crate) robot: String,
     pub(crate) joint_names: Vec<String>,
     pub(crate) environment: Environment,
     pub(crate) stances: Vec<Stance>,
+}
+
+/// A sequence as a stance source delivers it, impediments included.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RawSequence {
+    pub(crate) sequence: StanceSequence,
 }
 
 /// A sequence after Algorithm 1: the raw stances (`q_S` and contact flags unchanged, root
@@ -44,27 +51,13 @@ pub struct RawSequence {
 /// end-effector in every stance. This is what the controller executes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PostProcessedSequence {
-    pub(crate) robot: String,
-    pub(crate) joint_names: Vec<String>,
-    pub(crate) environment: Environment,
-    pub(crate) stances: Vec<Stance>,
+    pub(crate) sequence: StanceSequence,
     pub(crate) targets: Vec<[Isometry3<f64>; 4]>,
 }
 
-/// Accumulates the stance translations into global root poses `GP_S`.
-fn accumulate_roots(stances: &[Stance]) -> impl Iterator<Item = Isometry3<f64>> + '_ {
-    stances.iter().scan(Vector3::zeros(), |position, stance| {
-        *position += stance.translation;
-        Some(Isometry3::from_parts(
-            Translation3::from(*position),
-            stance.root_orientation,
-        ))
-    })
-}
-
-impl RawSequence {
-    /// A validated raw sequence (see [`FormatError`] for what is refused).
-    pub fn new(
+impl StanceSequence {
+    /// A validated sequence (see [`FormatError`] for what is refused).
+    fn new(
         robot: String,
         joint_names: Vec<String>,
         environment: Environment,
@@ -94,17 +87,17 @@ impl RawSequence {
         &self.environment
     }
 
-    /// The stances, never empty.
+    /// The stances (`q_S`, contact flags, root translations).
     pub fn stances(&self) -> &[Stance] {
         &self.stances
     }
 
-    /// Number of stances (≥ 1).
+    /// Number of stances (≥ 1 once validated).
     pub fn len(&self) -> usize {
         self.stances.len()
     }
 
-    /// Always false: an empty sequence is refused on construction.
+    /// False for a validated sequence (only [`PostProcessedSequence::empty`] has no stance).
     pub fn is_empty(&self) -> bool {
         self.stances.is_empty()
     }
@@ -120,6 +113,47 @@ impl RawSequence {
     }
 }
 
+impl std::ops::Deref for RawSequence {
+    type Target = StanceSequence;
+
+    fn deref(&self) -> &StanceSequence {
+        &self.sequence
+    }
+}
+
+impl std::ops::Deref for PostProcessedSequence {
+    type Target = StanceSequence;
+
+    fn deref(&self) -> &StanceSequence {
+        &self.sequence
+    }
+}
+
+/// Accumulates the stance translations into global root poses `GP_S`.
+fn accumulate_roots(stances: &[Stance]) -> impl Iterator<Item = Isometry3<f64>> + '_ {
+    stances.iter().scan(Vector3::zeros(), |position, stance| {
+        *position += stance.translation;
+        Some(Isometry3::from_parts(
+            Translation3::from(*position),
+            stance.root_orientation,
+        ))
+    })
+}
+
+impl RawSequence {
+    /// A validated raw sequence (see [`FormatError`] for what is refused).
+    pub fn new(
+        robot: String,
+        joint_names: Vec<String>,
+        environment: Environment,
+        stances: Vec<Stance>,
+    ) -> Result<Self, FormatError> {
+        Ok(Self {
+            sequence: StanceSequence::new(robot, joint_names, environment, stances)?,
+        })
+    }
+}
+
 impl PostProcessedSequence {
     /// A validated post-processed sequence; `targets` holds one pose per end-effector per stance.
     pub fn new(
@@ -129,13 +163,9 @@ impl PostProcessedSequence {
         stances: Vec<Stance>,
         targets: Vec<[Isometry3<f64>; 4]>,
     ) -> Result<Self, FormatError> {
-        validate(&robot, &joint_names, &environment, &stances)?;
         validate_targets(&targets, stances.len())?;
         Ok(Self {
-            robot,
-            joint_names,
-            environment,
-            stances,
+            sequence: StanceSequence::new(robot, joint_names, environment, stances)?,
             targets,
         })
     }
@@ -143,42 +173,9 @@ impl PostProcessedSequence {
     /// An empty value to be filled by [`crate::PostProcessor::process_into`] (reused buffers).
     pub fn empty() -> Self {
         Self {
-            robot: String::new(),
-            joint_names: Vec::new(),
-            environment: Environment::default(),
-            stances: Vec::new(),
+            sequence: StanceSequence::default(),
             targets: Vec::new(),
         }
-    }
-
-    /// Name of the robot the sequence is for.
-    pub fn robot(&self) -> &str {
-        &self.robot
-    }
-
-    /// Joint names, the order of every posture.
-    pub fn joint_names(&self) -> &[String] {
-        &self.joint_names
-    }
-
-    /// Support surfaces and hand affordances.
-    pub fn environment(&self) -> &Environment {
-        &self.environment
-    }
-
-    /// The stances (`q_S`, contact flags, root translations).
-    pub fn stances(&self) -> &[Stance] {
-        &self.stances
-    }
-
-    /// Number of stances.
-    pub fn len(&self) -> usize {
-        self.stances.len()
-    }
-
-    /// True only for [`PostProcessedSequence::empty`]; a validated sequence has stances.
-    pub fn is_empty(&self) -> bool {
-        self.stances.is_empty()
     }
 
     /// Contact flags of stance `i`, indexed by [`EndEffector`]. Panics if `i >= len()`.
@@ -200,16 +197,6 @@ impl PostProcessedSequence {
     /// The posture reference `q_S` of stance `i` (model joint order). Panics if `i >= len()`.
     pub fn posture(&self, i: usize) -> &[f64] {
         &self.stances[i].q
-    }
-
-    /// Global root pose of every stance after post-processing.
-    pub fn root_poses(&self) -> impl Iterator<Item = Isometry3<f64>> + '_ {
-        accumulate_roots(&self.stances)
-    }
-
-    /// Refuses the sequence if it is not for `robot` (name, joint names and order).
-    pub fn check_robot(&self, robot: &Robot) -> Result<(), FormatError> {
-        check_robot(&self.robot, &self.joint_names, robot)
     }
 }
 

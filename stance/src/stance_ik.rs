@@ -24,6 +24,8 @@ pub(crate) struct SolvedStance {
     /// The stance, root translation relative to the previous solved stance.
     pub stance: Stance,
     /// Remaining `[position, orientation]` error of the IK (m, rad).
+    // Reported by the learned source; the synthetic one poses stances the IK reaches exactly.
+    #[cfg_attr(not(feature = "learned"), allow(dead_code))]
     pub errors: [f64; 2],
 }
 

@@ -5,8 +5,8 @@ use std::time::Duration;
 use client::daemon_client::SubmitError;
 use shm_types::{DaemonLoopPorts, DaemonState, LinkState, SensorSample, ServiceNames};
 use walk_tests::{
-    connect_when_fresh, start_sim, start_walkd, unique_prefix, wait_for_status, wait_until,
-    walk_json,
+    connect_when_fresh, start_sim, start_walkd, start_walking, unique_prefix, wait_for_status,
+    wait_until, walk_json,
 };
 
 const START: Duration = Duration::from_secs(20);
@@ -16,15 +16,8 @@ const START: Duration = Duration::from_secs(20);
 #[test]
 fn adapter_killed_mid_walk_daemon_holds_then_accepts_a_new_sequence() {
     let prefix = unique_prefix("adapter_killed");
-    let mut walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
-    let sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
-    let client = connect_when_fresh(&prefix, START).unwrap();
+    let (walkd, sim, client) = start_walking("armar4", &prefix, 1.0).unwrap();
     let (json, _) = walk_json("armar4", 1.0).unwrap();
-    client.submit_json(&json).unwrap();
-    wait_for_status(&client, "executing", START, |s| {
-        s.state == DaemonState::Executing
-    })
-    .unwrap();
     std::thread::sleep(Duration::from_millis(300));
 
     sim.signal(libc::SIGKILL);
@@ -66,15 +59,7 @@ fn adapter_killed_mid_walk_daemon_holds_then_accepts_a_new_sequence() {
 #[test]
 fn daemon_killed_adapter_holds_position() {
     let prefix = unique_prefix("daemon_killed");
-    let mut walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
-    let mut sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
-    let client = connect_when_fresh(&prefix, START).unwrap();
-    let (json, _) = walk_json("armar4", 1.0).unwrap();
-    client.submit_json(&json).unwrap();
-    wait_for_status(&client, "executing", START, |s| {
-        s.state == DaemonState::Executing
-    })
-    .unwrap();
+    let (walkd, sim, _client) = start_walking("armar4", &prefix, 1.0).unwrap();
 
     // Watch the adapter's samples from the outside.
     let names = ServiceNames::new(&prefix).unwrap();

@@ -47,7 +47,7 @@ fn assert_within_limits(robot: &Robot, commands: &[Raw<shm_types::JointCommand>]
 #[test]
 fn unknown_enum_and_flag_values_are_refused_and_walkd_lives() {
     let prefix = unique_prefix("hostile_wire");
-    let mut walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
     let robot = robot("armar4");
     let mut adapter = RawAdapter::open_when_ready(&prefix, START).unwrap();
     let standing = standing_sample(&robot);
@@ -88,7 +88,7 @@ fn unknown_enum_and_flag_values_are_refused_and_walkd_lives() {
 #[test]
 fn a_sample_stamped_in_the_future_does_not_freeze_the_control_thread() {
     let prefix = unique_prefix("hostile_future");
-    let mut walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
     let robot = robot("armar4");
     let mut adapter = RawAdapter::open_when_ready(&prefix, START).unwrap();
     let standing = standing_sample(&robot);
@@ -456,7 +456,7 @@ fn a_greedy_process_cannot_lock_out_monitoring_or_the_adapter() {
 #[test]
 fn refusals_use_no_id_a_dead_walkd_is_named_at_once_and_bad_commands_do_not_flood_the_log() {
     let prefix = unique_prefix("hostile_small");
-    let mut walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
     let sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
     let client = connect_when_fresh(&prefix, START).unwrap();
     let (json, _) = walk_json("armar4", 0.3).unwrap();

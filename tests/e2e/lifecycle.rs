@@ -5,10 +5,10 @@ use std::os::unix::net::UnixDatagram;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use shm_types::{DaemonState, LinkState};
+use shm_types::LinkState;
 use walk_tests::{
-    connect_when_fresh, start_sim, start_walkd, start_walkd_with_env, unique_prefix,
-    wait_for_status, walk_json,
+    connect_when_fresh, start_sim, start_walkd, start_walkd_with_env, start_walking, unique_prefix,
+    walk_json,
 };
 
 const START: Duration = Duration::from_secs(20);
@@ -18,15 +18,7 @@ const START: Duration = Duration::from_secs(20);
 fn walkd_exits_cleanly_within_one_second_on_sigterm_and_sigint() {
     for (signal, name) in [(libc::SIGTERM, "sigterm"), (libc::SIGINT, "sigint")] {
         let prefix = unique_prefix(name);
-        let mut walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
-        let mut sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
-        let client = connect_when_fresh(&prefix, START).unwrap();
-        let (json, _) = walk_json("armar4", 0.3).unwrap();
-        client.submit_json(&json).unwrap();
-        wait_for_status(&client, "executing", START, |s| {
-            s.state == DaemonState::Executing
-        })
-        .unwrap();
+        let (walkd, sim, _client) = start_walking("armar4", &prefix, 0.3).unwrap();
 
         let sent = Instant::now();
         walkd.signal(signal);
@@ -60,7 +52,7 @@ fn walkd_exits_cleanly_within_one_second_on_sigterm_and_sigint() {
 #[test]
 fn walkd_restarts_after_kill_9_and_cleans_stale_resources() {
     let prefix = unique_prefix("restart");
-    let mut first = start_walkd("armar4", &prefix, "lockstep", 500.0).unwrap();
+    let first = start_walkd("armar4", &prefix, "lockstep", 500.0).unwrap();
     let _sim = start_sim("armar4", &prefix, "lockstep", 500.0).unwrap();
     let client = connect_when_fresh(&prefix, START).unwrap();
     let first_pid = client.status().unwrap().pid;
@@ -176,7 +168,7 @@ fn walkd_notifies_systemd_ready_status_watchdog_and_stopping() {
             // 2 s like configs/walkd@.service's WatchdogSec.
             env.push(("WATCHDOG_USEC", "2000000".as_ref()));
         }
-        let mut walkd = start_walkd_with_env("armar4", &prefix, "realtime", 500.0, &env).unwrap();
+        let walkd = start_walkd_with_env("armar4", &prefix, "realtime", 500.0, &env).unwrap();
         let _sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
 
         let ready = notify.wait_for(START, |m| m == "READY=1");
@@ -229,4 +221,46 @@ fn walkd_notifies_systemd_ready_status_watchdog_and_stopping() {
             notify.messages
         );
     }
+}
+
+/// The minimal adapter example of docs/adapter.md (sim-adapter/examples/minimal_adapter.rs)
+/// connects to a real walkd, serves its samples for a few periods, gets commands back and exits
+/// cleanly.
+#[test]
+fn the_minimal_adapter_example_serves_walkd_and_exits_cleanly() {
+    let prefix = unique_prefix("minimal_adapter");
+    let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
+    walkd.wait_for_log("walkd ready", START).unwrap();
+    let example = walk_tests::bin_dir().join("examples/minimal_adapter");
+    assert!(
+        example.is_file(),
+        "{} missing: cargo build --release -p sim-adapter --examples",
+        example.display()
+    );
+    let config = walk_tests::config("armar4");
+    let output = std::process::Command::new(&example)
+        .args([config.as_os_str(), "500".as_ref(), prefix.as_ref()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{}\n{stdout}\n{}",
+        output.status,
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let count = |what: &str| -> u64 {
+        stdout
+            .split(&format!(" {what}"))
+            .next()
+            .and_then(|s| s.rsplit(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no {what} count in `{stdout}`"))
+    };
+    assert!(count("samples") >= 500, "{stdout}");
+    assert!(
+        count("commands") > 400,
+        "walkd answered too few samples: {stdout}\n{}",
+        walkd.log()
+    );
 }

@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use iceoryx2::port::client::Client;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
@@ -128,12 +128,56 @@ pub fn standing_sample(robot: &Robot) -> SensorSample {
     sample
 }
 
+/// The sending end of one of walkd's streams (`sensors` or `commands`), with raw messages:
+/// publisher and wake-up notifier, numbering what it sends.
+struct RawSender<T: Copy + ZeroCopySend + 'static> {
+    publisher: Publisher<ipc::Service, Raw<T>, ()>,
+    notifier: Notifier<ipc::Service>,
+    seq: u64,
+}
+
+impl<T: Copy + ZeroCopySend + 'static> RawSender<T> {
+    /// Opens the stream `kind` under `prefix` (its other end created it).
+    fn open(node: &Node<ipc::Service>, prefix: &str, kind: &str) -> anyhow::Result<Self> {
+        let name = service_name(prefix, kind)?;
+        let stream = node
+            .service_builder(&name)
+            .publish_subscribe::<Raw<T>>()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening {kind}: {e:?}"))?;
+        let event = node
+            .service_builder(&name)
+            .event()
+            .open()
+            .map_err(|e| anyhow::anyhow!("opening the {kind} event: {e:?}"))?;
+        Ok(Self {
+            publisher: stream
+                .publisher_builder()
+                .create()
+                .map_err(|e| anyhow::anyhow!("publisher on {kind}: {e:?}"))?,
+            notifier: event
+                .notifier_builder()
+                .create()
+                .map_err(|e| anyhow::anyhow!("notifier on {kind}: {e:?}"))?,
+            seq: 0,
+        })
+    }
+
+    /// Sends `raw` with the next sequence number written at `seq_offset`; returns the number.
+    fn send(&mut self, mut raw: Raw<T>, seq_offset: usize) -> u64 {
+        self.seq += 1;
+        raw.put(seq_offset, self.seq);
+        let loan = self.publisher.loan_uninit().expect("loan a message");
+        loan.write_payload(raw).send().expect("send a message");
+        self.notifier.notify().expect("notify");
+        self.seq
+    }
+}
+
 /// An adapter that publishes raw sensor samples and reads walkd's commands.
 pub struct RawAdapter {
-    publisher: Publisher<ipc::Service, Raw<SensorSample>, ()>,
-    notifier: Notifier<ipc::Service>,
+    sensors: RawSender<SensorSample>,
     commands: Subscriber<ipc::Service, Raw<JointCommand>, ()>,
-    seq: u64,
     _node: Node<ipc::Service>,
 }
 
@@ -141,35 +185,17 @@ impl RawAdapter {
     /// Opens walkd's `sensors` and `commands` services under `prefix` (walkd created them).
     pub fn open(prefix: &str) -> anyhow::Result<Self> {
         let node = node("hostile-adapter")?;
-        let sensors = node
-            .service_builder(&service_name(prefix, "sensors")?)
-            .publish_subscribe::<Raw<SensorSample>>()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening sensors: {e:?}"))?;
-        let event = node
-            .service_builder(&service_name(prefix, "sensors")?)
-            .event()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening the sensors event: {e:?}"))?;
         let commands = node
             .service_builder(&service_name(prefix, "commands")?)
             .publish_subscribe::<Raw<JointCommand>>()
             .open()
             .map_err(|e| anyhow::anyhow!("opening commands: {e:?}"))?;
         Ok(Self {
-            publisher: sensors
-                .publisher_builder()
-                .create()
-                .map_err(|e| anyhow::anyhow!("publisher on sensors: {e:?}"))?,
-            notifier: event
-                .notifier_builder()
-                .create()
-                .map_err(|e| anyhow::anyhow!("notifier on sensors: {e:?}"))?,
+            sensors: RawSender::open(&node, prefix, "sensors")?,
             commands: commands
                 .subscriber_builder()
                 .create()
                 .map_err(|e| anyhow::anyhow!("subscriber on commands: {e:?}"))?,
-            seq: 0,
             _node: node,
         })
     }
@@ -200,18 +226,13 @@ impl RawAdapter {
     /// Publishes `raw` with the next sequence number (its other bytes as they are; a zero
     /// timestamp is replaced by now); returns the sequence number.
     pub fn publish_raw(&mut self, mut raw: Raw<SensorSample>) -> u64 {
-        self.seq += 1;
-        raw.put(offset_of!(SensorSample, seq), self.seq);
         if raw.get::<u64>(offset_of!(SensorSample, timestamp_ns)) == 0 {
             raw.put(
                 offset_of!(SensorSample, timestamp_ns),
                 shm_types::monotonic_ns(),
             );
         }
-        let loan = self.publisher.loan_uninit().expect("loan a sample");
-        loan.write_payload(raw).send().expect("send a sample");
-        self.notifier.notify().expect("notify");
-        self.seq
+        self.sensors.send(raw, offset_of!(SensorSample, seq))
     }
 
     /// Every command received since the last call, oldest first.
@@ -317,9 +338,7 @@ impl Drop for Feeder {
 
 /// A daemon that publishes raw joint commands to an adapter.
 pub struct RawDaemon {
-    publisher: Publisher<ipc::Service, Raw<JointCommand>, ()>,
-    notifier: Notifier<ipc::Service>,
-    seq: u64,
+    commands: RawSender<JointCommand>,
     _node: Node<ipc::Service>,
 }
 
@@ -327,43 +346,21 @@ impl RawDaemon {
     /// Opens the adapter's `commands` service under `prefix` (the adapter created it).
     pub fn open(prefix: &str) -> anyhow::Result<Self> {
         let node = node("hostile-daemon")?;
-        let commands = node
-            .service_builder(&service_name(prefix, "commands")?)
-            .publish_subscribe::<Raw<JointCommand>>()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening commands: {e:?}"))?;
-        let event = node
-            .service_builder(&service_name(prefix, "commands")?)
-            .event()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening the commands event: {e:?}"))?;
         Ok(Self {
-            publisher: commands
-                .publisher_builder()
-                .create()
-                .map_err(|e| anyhow::anyhow!("publisher on commands: {e:?}"))?,
-            notifier: event
-                .notifier_builder()
-                .create()
-                .map_err(|e| anyhow::anyhow!("notifier on commands: {e:?}"))?,
-            seq: 0,
+            commands: RawSender::open(&node, prefix, "commands")?,
             _node: node,
         })
     }
 
     /// Publishes `command` (numbered and stamped) after `edit` changed its raw bytes.
     pub fn publish(&mut self, command: &JointCommand, edit: impl FnOnce(&mut Raw<JointCommand>)) {
-        self.seq += 1;
         let mut raw = Raw::of(*command);
-        raw.put(offset_of!(JointCommand, seq), self.seq);
         raw.put(
             offset_of!(JointCommand, timestamp_ns),
             shm_types::monotonic_ns(),
         );
         edit(&mut raw);
-        let loan = self.publisher.loan_uninit().expect("loan a command");
-        loan.write_payload(raw).send().expect("send a command");
-        self.notifier.notify().expect("notify");
+        self.commands.send(raw, offset_of!(JointCommand, seq));
     }
 }
 
@@ -429,13 +426,7 @@ impl RawClient {
             .write_payload(request)
             .send()
             .map_err(|e| anyhow::anyhow!("send: {e:?}"))?;
-        let reply = wait(timeout, || {
-            pending
-                .receive()
-                .ok()
-                .flatten()
-                .map(|r| r.payload().clone())
-        })?;
+        let reply = wait_for_reply(timeout, || pending.receive().ok().flatten())?;
         Ok((
             reply.get::<u8>(offset_of!(ControlReply, accepted)) != 0,
             reply.text(offset_of!(ControlReply, message), 160),
@@ -451,18 +442,22 @@ impl RawClient {
             .write_from_slice(bytes)
             .send()
             .map_err(|e| anyhow::anyhow!("send: {e:?}"))?;
-        let reply = wait(timeout, || {
-            pending
-                .receive()
-                .ok()
-                .flatten()
-                .map(|r| r.payload().clone())
-        })?;
+        let reply = wait_for_reply(timeout, || pending.receive().ok().flatten())?;
         Ok((
             reply.get::<u8>(offset_of!(SubmitReply, accepted)) != 0,
             reply.text(offset_of!(SubmitReply, reason), 512),
         ))
     }
+}
+
+/// Waits up to `timeout` for `receive` to deliver the reply, and copies it.
+fn wait_for_reply<T: Copy + ZeroCopySend>(
+    timeout: Duration,
+    mut receive: impl FnMut() -> Option<iceoryx2::response::Response<ipc::Service, Raw<T>, ()>>,
+) -> anyhow::Result<Raw<T>> {
+    crate::wait_until("the reply", timeout, || {
+        receive().map(|r| r.payload().clone())
+    })
 }
 
 /// Holds ports of walkd's services as a greedy or leaking process would: up to `limit`
@@ -512,19 +507,5 @@ impl PortHog {
             _sensors: sensors,
             _node: node,
         })
-    }
-}
-
-/// Polls `poll` every millisecond until it yields a value or `timeout` passes.
-fn wait<T>(timeout: Duration, mut poll: impl FnMut() -> Option<T>) -> anyhow::Result<T> {
-    let start = Instant::now();
-    loop {
-        if let Some(value) = poll() {
-            return Ok(value);
-        }
-        if start.elapsed() > timeout {
-            bail!("no reply within {timeout:?}");
-        }
-        std::thread::sleep(Duration::from_millis(1));
     }
 }

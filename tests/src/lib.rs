@@ -7,17 +7,16 @@
 
 /// Peers that write raw message bytes to walkd's services.
 pub mod hostile;
-/// The controller walking under MuJoCo physics, in one process (feature `mujoco`).
-#[cfg(feature = "mujoco")]
-pub mod physics;
 
 use std::path::PathBuf;
-use std::process::{Child, Command, ExitStatus, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use client::daemon_client::DaemonClient;
-use shm_types::{DaemonStatus, LinkState};
+use client::process::{Launch, Process};
+use shm_types::DaemonStatus;
+use shm_types::process::Physics;
 
 /// The workspace root.
 pub fn workspace_dir() -> PathBuf {
@@ -43,151 +42,58 @@ pub fn unique_prefix(test: &str) -> String {
     format!("walk-e2e/{test}/{}", std::process::id())
 }
 
-/// A child process that is killed if the test ends while it still runs. Its stderr goes to a
-/// log file that [`Proc::log`] returns for failure messages.
-pub struct Proc {
-    name: String,
-    child: Child,
-    log: PathBuf,
-}
-
-impl Proc {
-    /// Starts `binary` (from [`bin_dir`]) with `args`.
-    pub fn start(binary: &str, args: &[String]) -> anyhow::Result<Self> {
-        Self::start_with_env(binary, args, &[])
+/// How a test starts walkd and walk-sim for `robot` on `prefix`.
+fn launch(robot: &str, prefix: &str, clock: &str, rate_hz: f64) -> Launch {
+    Launch {
+        bin_dir: bin_dir(),
+        config: config(robot),
+        prefix: prefix.to_owned(),
+        clock: clock.parse().expect("realtime or lockstep"),
+        rate_hz: Some(rate_hz),
+        urdf: None,
     }
-
-    /// Starts `binary` like [`Proc::start`], with extra environment variables (e.g. systemd's
-    /// `NOTIFY_SOCKET`).
-    pub fn start_with_env(
-        binary: &str,
-        args: &[String],
-        env: &[(&str, &std::ffi::OsStr)],
-    ) -> anyhow::Result<Self> {
-        let path = bin_dir().join(binary);
-        anyhow::ensure!(
-            path.is_file(),
-            "{} missing: build the binaries first (cargo build --release --bins) or set WALK_BIN_DIR",
-            path.display()
-        );
-        static COUNTER: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-        let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let log =
-            std::env::temp_dir().join(format!("walk-e2e-{}-{binary}-{n}.log", std::process::id()));
-        let child = Command::new(&path)
-            .args(args)
-            .envs(env.iter().copied())
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(std::fs::File::create(&log)?)
-            .spawn()
-            .with_context(|| format!("cannot start {}", path.display()))?;
-        Ok(Self {
-            name: binary.to_owned(),
-            child,
-            log,
-        })
-    }
-
-    /// Process id.
-    pub fn pid(&self) -> u32 {
-        self.child.id()
-    }
-
-    /// Sends `signal` (e.g. `libc::SIGTERM`, `libc::SIGKILL`).
-    pub fn signal(&self, signal: i32) {
-        // SAFETY: kill on our own child's pid has no memory-safety preconditions.
-        unsafe { libc::kill(self.child.id() as libc::pid_t, signal) };
-    }
-
-    /// Whether the process still runs.
-    pub fn is_running(&mut self) -> bool {
-        matches!(self.child.try_wait(), Ok(None))
-    }
-
-    /// Waits up to `timeout` for the exit; `None` if it still runs.
-    pub fn wait_exit(&mut self, timeout: Duration) -> Option<ExitStatus> {
-        let start = Instant::now();
-        loop {
-            if let Ok(Some(status)) = self.child.try_wait() {
-                return Some(status);
-            }
-            if start.elapsed() > timeout {
-                return None;
-            }
-            std::thread::sleep(Duration::from_millis(2));
-        }
-    }
-
-    /// Waits until the process's stderr contains `text`.
-    pub fn wait_for_log(&self, text: &str, timeout: Duration) -> anyhow::Result<()> {
-        wait_until(
-            &format!("`{text}` in the log of {}", self.name),
-            timeout,
-            || {
-                std::fs::read_to_string(&self.log)
-                    .ok()
-                    .filter(|log| log.contains(text))
-                    .map(|_| ())
-            },
-        )
-        .with_context(|| self.log())
-    }
-
-    /// The process's stderr so far (for failure messages).
-    pub fn log(&self) -> String {
-        let text = std::fs::read_to_string(&self.log).unwrap_or_default();
-        format!("--- {} stderr ---\n{text}", self.name)
-    }
-}
-
-impl Drop for Proc {
-    fn drop(&mut self) {
-        if self.is_running() {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
-        }
-        let _ = std::fs::remove_file(&self.log);
-    }
-}
-
-/// Common arguments of walkd and walk-sim.
-fn process_args(robot: &str, prefix: &str, clock: &str, rate_hz: f64) -> Vec<String> {
-    vec![
-        "--config".into(),
-        config(robot).display().to_string(),
-        "--service-prefix".into(),
-        prefix.into(),
-        "--clock".into(),
-        clock.into(),
-        "--rate-hz".into(),
-        rate_hz.to_string(),
-    ]
 }
 
 /// Starts `walkd` for `robot` on `prefix` (memory locking off: tests run unprivileged).
-pub fn start_walkd(robot: &str, prefix: &str, clock: &str, rate_hz: f64) -> anyhow::Result<Proc> {
+pub fn start_walkd(
+    robot: &str,
+    prefix: &str,
+    clock: &str,
+    rate_hz: f64,
+) -> anyhow::Result<Process> {
     start_walkd_with_env(robot, prefix, clock, rate_hz, &[])
 }
 
-/// Starts `walkd` like [`start_walkd`], with extra environment variables.
+/// Starts `walkd` like [`start_walkd`], with extra environment variables (e.g. systemd's
+/// `NOTIFY_SOCKET`).
 pub fn start_walkd_with_env(
     robot: &str,
     prefix: &str,
     clock: &str,
     rate_hz: f64,
     env: &[(&str, &std::ffi::OsStr)],
-) -> anyhow::Result<Proc> {
-    let mut args = process_args(robot, prefix, clock, rate_hz);
-    args.push("--no-lock-memory".into());
-    Proc::start_with_env("walkd", &args, env)
+) -> anyhow::Result<Process> {
+    check_binaries()?;
+    launch(robot, prefix, clock, rate_hz).walkd(&["--no-lock-memory"], env)
 }
 
 /// Starts `walk-sim --physics kinematic` for `robot` on `prefix`.
-pub fn start_sim(robot: &str, prefix: &str, clock: &str, rate_hz: f64) -> anyhow::Result<Proc> {
-    let mut args = process_args(robot, prefix, clock, rate_hz);
-    args.extend(["--physics".into(), "kinematic".into()]);
-    Proc::start("walk-sim", &args)
+pub fn start_sim(robot: &str, prefix: &str, clock: &str, rate_hz: f64) -> anyhow::Result<Process> {
+    check_binaries()?;
+    launch(robot, prefix, clock, rate_hz).walk_sim(Physics::Kinematic)
+}
+
+/// Fails with how to build them if the binaries under test are missing.
+fn check_binaries() -> anyhow::Result<()> {
+    for binary in ["walkd", "walk-sim", "walkctl"] {
+        let path = bin_dir().join(binary);
+        anyhow::ensure!(
+            path.is_file(),
+            "{} missing: build the binaries first (cargo build --release --bins) or set WALK_BIN_DIR",
+            path.display()
+        );
+    }
+    Ok(())
 }
 
 /// Polls `condition` every 10 ms until it holds or `timeout` passes (then the error names `what`).
@@ -210,11 +116,7 @@ pub fn wait_until<T>(
 
 /// Connects to the daemon on `prefix` once it serves and its adapter link is fresh.
 pub fn connect_when_fresh(prefix: &str, timeout: Duration) -> anyhow::Result<DaemonClient> {
-    wait_until("walkd with a fresh adapter link", timeout, || {
-        let client = DaemonClient::connect(prefix).ok()?;
-        let fresh = client.is_running() && client.status().ok()?.link == LinkState::Fresh;
-        fresh.then_some(client)
-    })
+    client::daemon_client::connect_when_fresh(prefix, &[], timeout)
 }
 
 /// Connects to the daemon on `prefix`, whatever its adapter link.
@@ -251,9 +153,28 @@ pub fn wait_for_status(
     })
 }
 
+/// Starts walkd and walk-sim for `robot` on `prefix` in real time at 500 Hz and submits a walk of
+/// `distance` metres; returns (walkd, walk-sim, a client) once it executes.
+pub fn start_walking(
+    robot: &str,
+    prefix: &str,
+    distance: f64,
+) -> anyhow::Result<(Process, Process, DaemonClient)> {
+    let start = Duration::from_secs(20);
+    let walkd = start_walkd(robot, prefix, "realtime", 500.0)?;
+    let sim = start_sim(robot, prefix, "realtime", 500.0)?;
+    let client = connect_when_fresh(prefix, start)?;
+    let (json, _) = walk_json(robot, distance)?;
+    client.submit_json(&json)?;
+    wait_for_status(&client, "executing", start, |s| {
+        s.state == shm_types::DaemonState::Executing
+    })?;
+    Ok((walkd, sim, client))
+}
+
 /// A post-processed forward walk of `distance` metres for `robot` (JSON) and its stance count.
 pub fn walk_json(robot: &str, distance: f64) -> anyhow::Result<(String, usize)> {
-    let config = config(robot);
-    let model = kinematics::robot::Robot::load(&config, None)?;
-    client::demo::walk_sequence(&model, &config, distance, 1)
+    let file = kinematics::ConfigFile::load(&config(robot))?;
+    let model = kinematics::robot::Robot::from_config(&file, None)?;
+    client::demo::walk_sequence(&model, &file, distance, 1)
 }

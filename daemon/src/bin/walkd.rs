@@ -1,30 +1,15 @@
-//! `walkd`: the walking daemon.
-//!
-//! Without a subcommand it runs the long-lived daemon (`daemon::runtime`); `walkd bench` executes
-//! a generated walk in-process against the kinematic simulator (`daemon::bench`).
+//! `walkd`: the walking daemon (`daemon::runtime`).
 
-use clap::{Parser, Subcommand};
+use clap::Parser;
 
 /// The real-time walking daemon.
 #[derive(Parser)]
-#[command(name = "walkd", version, about, args_conflicts_with_subcommands = true)]
+#[command(name = "walkd", version, about)]
 struct Cli {
-    #[command(subcommand)]
-    command: Option<Command>,
     #[command(flatten)]
     daemon: daemon::runtime::DaemonArgs,
 }
 
-#[derive(Subcommand)]
-enum Command {
-    /// Generate, post-process and execute a walk in-process against the kinematic simulator.
-    Bench(daemon::bench::BenchArgs),
-}
-
 fn main() -> std::process::ExitCode {
-    let cli = Cli::parse();
-    match cli.command {
-        Some(Command::Bench(args)) => daemon::bench::main(&args),
-        None => daemon::runtime::main(&cli.daemon),
-    }
+    daemon::runtime::main(&Cli::parse().daemon)
 }

@@ -22,7 +22,7 @@ use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{DMatrix, DVector, Isometry3, UnitQuaternion, Vector3};
 
-use kinematic_sim::support::{MAX_SUPPORT_POINTS, SupportPolygon, sole_corners};
+use kinematics::ground::{MAX_SUPPORT_POINTS, SupportPolygon, sole_corners};
 
 use super::config::ControllerConfig;
 use super::machine::{PoseTarget, Targets};

@@ -13,7 +13,7 @@ use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-use kinematic_sim::support::sole_corners;
+use kinematics::ground::sole_corners;
 
 /// Feet closer than this to the lowest sole when the world frame is set up count as standing (m).
 const STANDING_TOLERANCE: f64 = 2e-3;

@@ -6,10 +6,10 @@
 //! agree with the state machine. Every phase has a planned duration; exceeding it by the
 //! configured timeout is a fault.
 
-use kinematic_sim::support::{SupportPolygon, sole_corners};
+use kinematics::ground::{SupportPolygon, sole_corners};
+use kinematics::ground::{planar_frame, sequence_alignment};
 use kinematics::robot::{EndEffector, SoleRectangle};
 use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
-use stance::geometry::{planar_frame, sequence_alignment};
 
 use super::config::ControllerConfig;
 use super::plan::{Step, TransitionPlan};

@@ -220,7 +220,7 @@ impl Controller {
             )),
             SolverKind::Clarabel => Box::new(ClarabelSolver::new()),
         };
-        let weight = model.total_mass() * kinematic_sim::GRAVITY;
+        let weight = model.total_mass() * kinematics::ground::GRAVITY;
         Ok(Controller {
             kinematics: Kinematics::new(model),
             configuration: robot.standing.clone(),

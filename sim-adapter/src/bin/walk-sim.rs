@@ -14,17 +14,15 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Duration;
 
-use clap::{Parser, ValueEnum};
-use kinematic_sim::SafetySummary;
+use clap::Parser;
+use kinematic_sim::{KinematicSim, Simulator};
 use kinematics::ConfigFile;
 use kinematics::robot::Robot;
-use shm_types::process::{exit_code, install_termination_handler, termination_requested};
+use shm_types::process::{Physics, exit_code, install_termination_handler, termination_requested};
 use shm_types::{
     AdapterPorts, ClockMode, RuntimeConfig, ServiceNames, TruthPublisher, current_thread_is_fifo,
 };
-use sim_adapter::{
-    AdapterOptions, GroundTruth, KinematicRobot, PublishTruth, RobotIo, run_adapter,
-};
+use sim_adapter::{AdapterOptions, PublishTruth, SimulatedRobot, run_adapter};
 
 /// Simulated robot for walkd: publishes sensor samples, applies joint commands.
 #[derive(Parser)]
@@ -48,15 +46,6 @@ struct Args {
     /// Service prefix, overriding `[runtime] service_prefix`.
     #[arg(long)]
     service_prefix: Option<String>,
-}
-
-/// The simulator backends.
-#[derive(Clone, Copy, ValueEnum)]
-enum Physics {
-    /// Deterministic kinematic simulator (ideal servos, feet anchored in contact).
-    Kinematic,
-    /// MuJoCo rigid-body dynamics with contacts (needs --features sim-adapter/mujoco).
-    Mujoco,
 }
 
 fn main() -> ExitCode {
@@ -100,9 +89,10 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
     let robot = Arc::new(robot);
     match args.physics {
         Physics::Kinematic => {
-            let sim = KinematicRobot::standing(robot)
+            let standing = robot.standing.clone();
+            let sim = KinematicSim::new(robot, standing)
                 .map_err(|e| config_error(anyhow::Error::from(e).context("standing posture")))?;
-            serve(&runtime, args.clock, sim, |sim| *sim.summary())
+            serve(&runtime, args.clock, SimulatedRobot::new(sim))
         }
         Physics::Mujoco => serve_mujoco(robot, &runtime, args.clock),
     }
@@ -115,15 +105,15 @@ fn serve_mujoco(
     runtime: &RuntimeConfig,
     clock: ClockMode,
 ) -> Result<(), (u8, anyhow::Error)> {
-    use sim_adapter::mujoco::{MujocoOptions, MujocoRobot};
-    let urdf = robot.urdf.clone();
-    let sim = MujocoRobot::standing(robot, &urdf, MujocoOptions::default()).map_err(|e| {
+    use sim_adapter::mujoco::{MujocoOptions, MujocoSim};
+    let (urdf, standing) = (robot.urdf.clone(), robot.standing.clone());
+    let sim = MujocoSim::new(robot, &urdf, &standing, MujocoOptions::default()).map_err(|e| {
         (
             exit_code::CONFIG,
             anyhow::Error::from(e).context("MuJoCo model"),
         )
     })?;
-    serve(runtime, clock, sim, |sim| *sim.summary())
+    serve(runtime, clock, SimulatedRobot::new(sim))
 }
 
 /// `--physics mujoco` in a build without the backend: says how to get it.
@@ -145,11 +135,10 @@ fn serve_mujoco(
 
 /// Runs the adapter loop for `sim` until terminated, publishing its ground truth with every
 /// sample; logs the simulator's safety summary.
-fn serve<R: RobotIo + GroundTruth>(
+fn serve<S: Simulator>(
     runtime: &RuntimeConfig,
     clock: ClockMode,
-    sim: R,
-    summary: impl Fn(&R) -> SafetySummary,
+    sim: SimulatedRobot<S>,
 ) -> Result<(), (u8, anyhow::Error)> {
     let names =
         ServiceNames::new(&runtime.service_prefix).map_err(|e| (exit_code::IPC, e.into()))?;
@@ -181,7 +170,7 @@ fn serve<R: RobotIo + GroundTruth>(
     );
     let report = run_adapter(&ports, &mut sim, &options, &termination_requested)
         .map_err(|e| (exit_code::IPC, e.into()))?;
-    let safety = summary(sim.robot());
+    let safety = *sim.robot().sim().summary();
     tracing::info!(
         samples = report.samples,
         commands = report.commands,

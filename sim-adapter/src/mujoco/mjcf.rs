@@ -56,7 +56,7 @@ pub(crate) fn write(
         xml,
         r#"  <option timestep="{}" integrator="implicitfast" gravity="0 0 -{}" cone="elliptic"/>"#,
         o.timestep,
-        kinematic_sim::GRAVITY
+        kinematics::ground::GRAVITY
     );
     let _ = writeln!(xml, "  <default>");
     let _ = writeln!(

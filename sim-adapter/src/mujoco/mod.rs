@@ -6,7 +6,8 @@
 //! the `[robot]` section's frames (`mjcf` documents every modelling choice); [`MujocoSim`] steps
 //! it with joint servos tracking `q_des` / `q̇_des` and reports the same [`SimMeasurement`]
 //! record as `kinematic_sim::KinematicSim`, plus base height and tilt for fall detection.
-//! [`MujocoRobot`] puts it behind [`crate::RobotIo`] for the adapter loop.
+//! It is a [`kinematic_sim::Simulator`], so [`crate::SimulatedRobot`] puts it behind
+//! [`crate::RobotIo`] for the adapter loop.
 //!
 //! [`SimMeasurement`]: kinematic_sim::SimMeasurement
 
@@ -15,10 +16,8 @@ mod contact;
 mod error;
 mod mjcf;
 mod options;
-mod robot_io;
 mod sim;
 
 pub use error::MujocoError;
 pub use options::MujocoOptions;
-pub use robot_io::MujocoRobot;
 pub use sim::MujocoSim;

@@ -4,9 +4,9 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use kinematic_sim::support::{SupportPolygon, sole_corners};
-use kinematic_sim::{SafetyMetrics, SafetySummary, SimMeasurement, check_joint_vector};
+use kinematic_sim::{SafetyMetrics, SafetySummary, SimMeasurement, Simulator, check_joint_vector};
 use kinematics::configuration::Configuration;
+use kinematics::ground::{SupportPolygon, sole_corners};
 use kinematics::robot::{EndEffector, Robot};
 use mujoco_rs::prelude::{MjData, MjModel, MjtObjBase, MjtWarning};
 use nalgebra::{
@@ -127,31 +127,9 @@ impl MujocoSim {
         Ok(sim)
     }
 
-    /// The robot being simulated.
-    pub fn robot(&self) -> &Arc<Robot> {
-        &self.robot
-    }
-
     /// The options the model was built with.
     pub fn options(&self) -> &MujocoOptions {
         &self.options
-    }
-
-    /// Simulated time since the start (s).
-    pub fn time(&self) -> f64 {
-        self.data.time()
-    }
-
-    /// The current sensor readings, ground truth and safety metrics (same record as the
-    /// kinematic simulator's): joint `q`/`q̇`, foot FT wrenches (hands read zero: only the floor
-    /// is modelled), the IMU orientation, and the true base pose, CoM and contacts.
-    pub fn measurement(&self) -> &SimMeasurement {
-        &self.measurement
-    }
-
-    /// Worst safety values since the start; `fell` is set by [`MujocoSim::has_fallen`]'s rule.
-    pub fn summary(&self) -> &SafetySummary {
-        &self.summary
     }
 
     /// The IMU at the floating base origin (the URDF root link): angular velocity (rad/s) and
@@ -162,18 +140,6 @@ impl MujocoSim {
             Vector3::from_column_slice(&s[mjcf::IMU_GYRO]),
             Vector3::from_column_slice(&s[mjcf::IMU_ACCEL]),
         )
-    }
-
-    /// World pose of the configured `base_link` (the pelvis), for fall detection.
-    pub fn base_link_pose(&self) -> Isometry3<f64> {
-        let body = self.layout.base_link_body;
-        let [x, y, z] = self.data.xpos()[body];
-        let [w, i, j, k] = self.data.xquat()[body];
-        let pose = Isometry3::from_parts(
-            Translation3::new(x, y, z),
-            UnitQuaternion::from_quaternion(Quaternion::new(w, i, j, k)),
-        );
-        pose * self.layout.base_link_offset
     }
 
     /// Height of the `base_link` origin above the floor (m).
@@ -191,59 +157,6 @@ impl MujocoSim {
     pub fn has_fallen(&self) -> bool {
         self.base_height() < self.options.fall_height_fraction * self.initial_base_height
             || self.torso_tilt() > self.options.fall_tilt
-    }
-
-    /// World pose of an end-effector frame (sole or palm) in the simulator.
-    pub fn end_effector_pose(&self, effector: EndEffector) -> Isometry3<f64> {
-        let site = self.layout.effector_sites[effector as usize];
-        let position = Vector3::from(self.data.site_xpos()[site]);
-        let rotation =
-            Rotation3::from_matrix_unchecked(Matrix3::from_row_slice(&self.data.site_xmat()[site]));
-        Isometry3::from_parts(
-            Translation3::from(position),
-            UnitQuaternion::from_rotation_matrix(&rotation),
-        )
-    }
-
-    /// Advances by `dt` with the servos tracking `q_des` (clamped into the joint limits, each clamp
-    /// counted as a violation) and `qd_des`. Runs the physics steps that fit: a `dt` that is not a
-    /// multiple of the time step carries its remainder into the next call, and a call with no
-    /// step due leaves the measurement as it was.
-    pub fn step(&mut self, q_des: &[f64], qd_des: &[f64], dt: f64) -> Result<(), MujocoError> {
-        self.check_command("q_des", q_des)?;
-        self.check_command("qd_des", qd_des)?;
-        let substeps = self.substeps(dt)?;
-        let mut violations = 0;
-        let limits = self.robot.model.joint_limits();
-        let ctrl = self.data.ctrl_mut();
-        for (j, ((&q, &qd), limit)) in q_des.iter().zip(qd_des).zip(limits).enumerate() {
-            let target = q.clamp(limit.lower, limit.upper);
-            violations += usize::from(target != q);
-            ctrl[2 * j] = target;
-            ctrl[2 * j + 1] = qd;
-        }
-        let warnings_before = self.fatal_warning_count();
-        for substep in 0..substeps {
-            // Forward dynamics of the current state, the constraint solve and the integration.
-            self.data.step2();
-            if substep + 1 == substeps {
-                // The contact list, solved forces and poses still describe the same state here.
-                self.contacts = contact::read(&self.data, &self.layout.feet);
-            }
-            // Kinematics, collisions and position/velocity sensors of the new state.
-            self.data.step1();
-        }
-        if substeps == 0 {
-            return Ok(());
-        }
-        if self.fatal_warning_count() != warnings_before {
-            return Err(MujocoError::Unstable {
-                time: self.data.time(),
-            });
-        }
-        self.record(violations);
-        self.summary.steps += 1;
-        Ok(())
     }
 
     /// Puts the robot in `initial`, at rest, and evaluates it.
@@ -481,6 +394,91 @@ fn require_all(
             requirement,
         }),
         None => Ok(()),
+    }
+}
+
+/// The servos track `q_des` (clamped into the joint limits, each clamp counted as a violation)
+/// and `qd_des`; a step runs the physics steps that fit in `dt` and carries the remainder into
+/// the next call (a call with no step due leaves the measurement as it was). The measurement is
+/// the same record as the kinematic simulator's: joint `q`/`q̇`, foot FT wrenches (hands read
+/// zero: only the floor is modelled), the IMU orientation, and the true base pose, CoM and
+/// contacts; the summary's `fell` is set by [`MujocoSim::has_fallen`]'s rule.
+impl Simulator for MujocoSim {
+    type Error = MujocoError;
+
+    fn robot(&self) -> &Arc<Robot> {
+        &self.robot
+    }
+
+    fn step(&mut self, q_des: &[f64], qd_des: &[f64], dt: f64) -> Result<(), MujocoError> {
+        self.check_command("q_des", q_des)?;
+        self.check_command("qd_des", qd_des)?;
+        let substeps = self.substeps(dt)?;
+        let mut violations = 0;
+        let limits = self.robot.model.joint_limits();
+        let ctrl = self.data.ctrl_mut();
+        for (j, ((&q, &qd), limit)) in q_des.iter().zip(qd_des).zip(limits).enumerate() {
+            let target = q.clamp(limit.lower, limit.upper);
+            violations += usize::from(target != q);
+            ctrl[2 * j] = target;
+            ctrl[2 * j + 1] = qd;
+        }
+        let warnings_before = self.fatal_warning_count();
+        for substep in 0..substeps {
+            // Forward dynamics of the current state, the constraint solve and the integration.
+            self.data.step2();
+            if substep + 1 == substeps {
+                // The contact list, solved forces and poses still describe the same state here.
+                self.contacts = contact::read(&self.data, &self.layout.feet);
+            }
+            // Kinematics, collisions and position/velocity sensors of the new state.
+            self.data.step1();
+        }
+        if substeps == 0 {
+            return Ok(());
+        }
+        if self.fatal_warning_count() != warnings_before {
+            return Err(MujocoError::Unstable {
+                time: self.data.time(),
+            });
+        }
+        self.record(violations);
+        self.summary.steps += 1;
+        Ok(())
+    }
+
+    fn measurement(&self) -> &SimMeasurement {
+        &self.measurement
+    }
+
+    fn summary(&self) -> &SafetySummary {
+        &self.summary
+    }
+
+    fn end_effector_pose(&self, effector: EndEffector) -> Isometry3<f64> {
+        let site = self.layout.effector_sites[effector as usize];
+        let position = Vector3::from(self.data.site_xpos()[site]);
+        let rotation =
+            Rotation3::from_matrix_unchecked(Matrix3::from_row_slice(&self.data.site_xmat()[site]));
+        Isometry3::from_parts(
+            Translation3::from(position),
+            UnitQuaternion::from_rotation_matrix(&rotation),
+        )
+    }
+
+    fn base_link_pose(&self) -> Isometry3<f64> {
+        let body = self.layout.base_link_body;
+        let [x, y, z] = self.data.xpos()[body];
+        let [w, i, j, k] = self.data.xquat()[body];
+        let pose = Isometry3::from_parts(
+            Translation3::new(x, y, z),
+            UnitQuaternion::from_quaternion(Quaternion::new(w, i, j, k)),
+        );
+        pose * self.layout.base_link_offset
+    }
+
+    fn time(&self) -> f64 {
+        self.data.time()
     }
 }
 

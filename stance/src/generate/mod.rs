@@ -19,10 +19,10 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::environment::{Environment, HandAffordance};
 use crate::error::FormatError;
-use crate::geometry::yaw;
 use crate::sequence::{RawSequence, Stance};
 use crate::stance_ik::StanceIk;
 use gait::{Body, PlannedStance, Railing};
+use kinematics::ground::yaw;
 
 /// Pelvis height of the human the statistics describe (metres); the robot's pelvis height over
 /// it is the retargeting scale of all lengths.

@@ -13,7 +13,9 @@ use super::model::NgramModel;
 use super::query::Search;
 use super::retarget::{LearnedOptions, generate_learned};
 use crate::generate::{GenerateError, GenerateOptions, generate_with_railing};
-use crate::sequence::RawSequence;
+use crate::params::PostProcessParams;
+use crate::sequence::{PostProcessedSequence, RawSequence};
+use crate::walk::{WalkError, WalkRequest, walk_with};
 
 /// Which generator a command uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -167,6 +169,19 @@ impl StanceSource {
                 path, beam: None, ..
             } => format!("learned ({}, sampled, seed {seed})", path.display()),
         }
+    }
+
+    /// The walk of `request` from this source, post-processed with `params` (the railing, if
+    /// any, available along the whole walk).
+    pub fn walk(
+        &self,
+        robot: &Robot,
+        params: &PostProcessParams,
+        request: &WalkRequest,
+    ) -> Result<PostProcessedSequence, WalkError<SourceError>> {
+        walk_with(robot, params, request, |options| {
+            Ok(self.generate(robot, options, None)?.raw)
+        })
     }
 
     /// Generates a raw sequence covering `options.distance` (raw-scale metres: divide by scf

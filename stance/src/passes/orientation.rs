@@ -79,8 +79,8 @@ pub fn limit_swing_foot_rotation(
 mod tests {
     use super::*;
     use crate::environment::SupportSurface;
-    use crate::geometry::yaw;
     use crate::passes::fixtures::{BOTH, LEFT, rotated, stance, walk};
+    use kinematics::ground::yaw;
     use kinematics::robot::EndEffector::{LeftFoot, RightFoot};
     use nalgebra::Isometry3;
 

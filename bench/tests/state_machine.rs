@@ -6,6 +6,7 @@ mod walk_support;
 use daemon::controller::{
     CommandMode, ControllerState, FaultCode, MeasurementFault, Phase, StartRefusal,
 };
+use kinematic_sim::Simulator;
 use kinematics::robot::EndEffector;
 use walk_support::Harness;
 
@@ -25,7 +26,7 @@ fn run_until(h: &mut Harness, phase: Phase) {
     for _ in 0..MAX_TICKS {
         h.tick();
         h.assert_safe();
-        let status = h.controller.status();
+        let status = h.closed.controller.status();
         assert_eq!(status.state, ControllerState::Executing, "{status:?}");
         if status.phase == phase {
             return;
@@ -40,7 +41,7 @@ fn walk_to_done(h: &mut Harness, mut observe: impl FnMut(&Harness)) {
     for _ in 0..MAX_TICKS {
         h.tick();
         h.assert_safe();
-        let status = h.controller.status();
+        let status = h.closed.controller.status();
         if status.state == ControllerState::Done {
             return;
         }
@@ -56,22 +57,25 @@ fn touchdown_never_confirmed_is_a_lower_timeout_fault() {
     run_until(&mut h, Phase::Lower);
     // The force-torque sensor of the landing (right) foot reads nothing from now on.
     let mut ticks = 0;
-    while h.controller.status().state == ControllerState::Executing && ticks < MAX_TICKS {
+    while h.closed.controller.status().state == ControllerState::Executing && ticks < MAX_TICKS {
         h.tick_with(|w| w[EndEffector::RightFoot as usize] = [0.0; 6]);
         ticks += 1;
     }
-    let status = *h.controller.status();
+    let status = *h.closed.controller.status();
     assert_eq!(status.state, ControllerState::Fault);
     assert_eq!(status.fault, FaultCode::Timeout(Phase::Lower));
     assert!(
         !status.contacts[EndEffector::RightFoot as usize],
         "contact never confirmed"
     );
-    assert_eq!(h.command.mode, CommandMode::Hold);
-    let held = h.command.q_des.clone();
+    assert_eq!(h.closed.command.mode, CommandMode::Hold);
+    let held = h.closed.command.q_des.clone();
     for _ in 0..50 {
         h.tick_with(|w| w[EndEffector::RightFoot as usize] = [0.0; 6]);
-        assert_eq!(h.command.q_des, held, "a fault holds the last safe command");
+        assert_eq!(
+            h.closed.command.q_des, held,
+            "a fault holds the last safe command"
+        );
     }
     h.assert_safe();
 }
@@ -81,35 +85,35 @@ fn force_spikes_while_swinging_or_above_the_ground_are_not_touchdowns() {
     let mut h = started("jvrc1", false);
     run_until(&mut h, Phase::Swing);
     // A sustained spike on the swinging foot: ignored outside the lowering phase.
-    let spike = 2.0 * h.robot.model.total_mass() * kinematic_sim::GRAVITY;
+    let spike = 2.0 * h.robot.model.total_mass() * kinematics::ground::GRAVITY;
     for _ in 0..20 {
         h.tick_with(|w| w[EndEffector::RightFoot as usize][2] = spike);
         h.assert_safe();
-        assert_eq!(h.controller.status().phase, Phase::Swing);
-        assert!(!h.controller.status().contacts[EndEffector::RightFoot as usize]);
+        assert_eq!(h.closed.controller.status().phase, Phase::Swing);
+        assert!(!h.closed.controller.status().contacts[EndEffector::RightFoot as usize]);
     }
     run_until(&mut h, Phase::Lower);
     // Single-tick spikes while lowering, before the sole reaches the ground: debounced away.
     for k in 0..30 {
-        let foot_in_air = !h.sim.measurement().contacts[EndEffector::RightFoot as usize];
+        let foot_in_air = !h.closed.sim.measurement().contacts[EndEffector::RightFoot as usize];
         assert!(foot_in_air, "the sole is still above the ground");
         if k % 2 == 0 {
             h.tick_with(|w| w[EndEffector::RightFoot as usize][2] = spike);
         } else {
             h.tick();
         }
-        assert_eq!(h.controller.status().phase, Phase::Lower);
-        assert!(!h.controller.status().contacts[EndEffector::RightFoot as usize]);
+        assert_eq!(h.closed.controller.status().phase, Phase::Lower);
+        assert!(!h.closed.controller.status().contacts[EndEffector::RightFoot as usize]);
     }
     // The real touchdown is confirmed and the walk finishes.
     for _ in 0..MAX_TICKS {
         h.tick();
         h.assert_safe();
-        if h.controller.status().state != ControllerState::Executing {
+        if h.closed.controller.status().state != ControllerState::Executing {
             break;
         }
     }
-    assert_eq!(h.controller.status().state, ControllerState::Done);
+    assert_eq!(h.closed.controller.status().state, ControllerState::Done);
 }
 
 #[test]
@@ -128,23 +132,23 @@ fn abort_in_every_phase_holds_safely_and_a_new_sequence_can_start() {
         for _ in 0..5 {
             h.tick();
         }
-        h.controller.abort();
+        h.closed.controller.abort();
         assert_eq!(
-            h.controller.status().state,
+            h.closed.controller.status().state,
             ControllerState::Holding,
             "{phase:?}"
         );
         h.tick();
-        let held = h.command.q_des.clone();
+        let held = h.closed.command.q_des.clone();
         for _ in 0..200 {
             h.tick();
             h.assert_safe();
-            assert_eq!(h.command.mode, CommandMode::Hold, "{phase:?}");
+            assert_eq!(h.closed.command.mode, CommandMode::Hold, "{phase:?}");
             assert_eq!(
-                h.command.q_des, held,
+                h.closed.command.q_des, held,
                 "{phase:?}: holding keeps the posture"
             );
-            assert_eq!(h.controller.status().state, ControllerState::Holding);
+            assert_eq!(h.closed.controller.status().state, ControllerState::Holding);
         }
         // From Holding, a new sequence (from wherever the robot stands) runs to the end.
         let sequence = walk_support::synthetic_walk(&h.robot, 2, 0.05, false);
@@ -152,15 +156,15 @@ fn abort_in_every_phase_holds_safely_and_a_new_sequence_can_start() {
         for _ in 0..MAX_TICKS {
             h.tick();
             h.assert_safe();
-            if h.controller.status().state != ControllerState::Executing {
+            if h.closed.controller.status().state != ControllerState::Executing {
                 break;
             }
         }
         assert_eq!(
-            h.controller.status().state,
+            h.closed.controller.status().state,
             ControllerState::Done,
             "{phase:?}: {:?}",
-            h.controller.status()
+            h.closed.controller.status()
         );
     }
 }
@@ -172,42 +176,56 @@ fn start_is_refused_while_executing_and_in_fault_until_reset() {
     let config = walk_support::controller_config("jvrc1");
     let sequence = walk_support::synthetic_walk(&h.robot, 1, 0.05, false);
     let prepared = daemon::controller::Controller::prepare(&h.robot, &config, &sequence).unwrap();
-    let (refused, why) = h.controller.start(Box::new(prepared)).unwrap_err();
+    let (refused, why) = h.closed.controller.start(Box::new(prepared)).unwrap_err();
     assert_eq!(why, StartRefusal::Busy);
     // A non-finite measurement faults the controller; it then refuses until reset.
-    let q: Vec<f64> = h.sim.measurement().q.iter().map(|_| f64::NAN).collect();
+    let q: Vec<f64> = h
+        .closed
+        .sim
+        .measurement()
+        .q
+        .iter()
+        .map(|_| f64::NAN)
+        .collect();
     let measurement = daemon::controller::Measurement {
         q: &q,
-        qd: h.sim.measurement().qd.as_slice(),
-        wrenches: &h.sim.measurement().wrenches,
+        qd: h.closed.sim.measurement().qd.as_slice(),
+        wrenches: &h.closed.sim.measurement().wrenches,
         imu_orientation: None,
     };
-    let before = h.command.q_des.clone();
-    assert!(h.controller.tick(&measurement, h.dt, &mut h.command));
-    assert_eq!(h.controller.status().state, ControllerState::Fault);
+    let before = h.closed.command.q_des.clone();
+    assert!(
+        h.closed
+            .controller
+            .tick(&measurement, h.dt, &mut h.closed.command)
+    );
+    assert_eq!(h.closed.controller.status().state, ControllerState::Fault);
     assert_eq!(
-        h.controller.status().fault,
+        h.closed.controller.status().fault,
         FaultCode::InvalidMeasurement(MeasurementFault::NonFiniteAngle(0))
     );
-    assert_eq!(h.command.q_des, before, "holds the last safe command");
-    assert_eq!(h.command.mode, CommandMode::Hold);
-    let (refused, why) = h.controller.start(refused).unwrap_err();
+    assert_eq!(
+        h.closed.command.q_des, before,
+        "holds the last safe command"
+    );
+    assert_eq!(h.closed.command.mode, CommandMode::Hold);
+    let (refused, why) = h.closed.controller.start(refused).unwrap_err();
     assert_eq!(why, StartRefusal::Faulted);
-    h.controller.reset().unwrap();
-    assert_eq!(h.controller.status().state, ControllerState::Holding);
+    h.closed.controller.reset().unwrap();
+    assert_eq!(h.closed.controller.status().state, ControllerState::Holding);
     // The last measurement was invalid: a walk starts only from a valid one.
-    let (refused, why) = h.controller.start(refused).unwrap_err();
+    let (refused, why) = h.closed.controller.start(refused).unwrap_err();
     assert_eq!(why, StartRefusal::NoMeasurement);
     h.tick();
-    assert!(h.controller.start(refused).is_ok());
+    assert!(h.closed.controller.start(refused).is_ok());
     for _ in 0..MAX_TICKS {
         h.tick();
         h.assert_safe();
-        if h.controller.status().state != ControllerState::Executing {
+        if h.closed.controller.status().state != ControllerState::Executing {
             break;
         }
     }
-    assert_eq!(h.controller.status().state, ControllerState::Done);
+    assert_eq!(h.closed.controller.status().state, ControllerState::Done);
 }
 
 #[test]
@@ -228,9 +246,12 @@ fn an_imu_that_disagrees_with_leg_odometry_is_a_tipping_fault_that_holds() {
     for _ in 0..50 {
         h.tick();
     }
-    assert_eq!(h.controller.status().state, ControllerState::Executing);
+    assert_eq!(
+        h.closed.controller.status().state,
+        ControllerState::Executing
+    );
     let config = walk_support::controller_config("jvrc1");
-    let m = h.sim.measurement().clone();
+    let m = h.closed.sim.measurement().clone();
     // The IMU reports the base rolled just under, then just over, the detection angle.
     let roll = |angle: f64| {
         nalgebra::UnitQuaternion::from_euler_angles(angle, 0.0, 0.0) * m.base_orientation
@@ -245,15 +266,22 @@ fn an_imu_that_disagrees_with_leg_odometry_is_a_tipping_fault_that_holds() {
             wrenches: &m.wrenches,
             imu_orientation: Some(roll(angle)),
         };
-        let before = h.command.q_des.clone();
-        assert!(h.controller.tick(&measurement, h.dt, &mut h.command));
+        let before = h.closed.command.q_des.clone();
+        assert!(
+            h.closed
+                .controller
+                .tick(&measurement, h.dt, &mut h.closed.command)
+        );
         if tipping {
-            assert_eq!(h.controller.status().state, ControllerState::Fault);
-            assert_eq!(h.controller.status().fault, FaultCode::Tipping);
-            assert_eq!(h.command.q_des, before, "holds the last command");
-            assert_eq!(h.command.mode, CommandMode::Hold);
+            assert_eq!(h.closed.controller.status().state, ControllerState::Fault);
+            assert_eq!(h.closed.controller.status().fault, FaultCode::Tipping);
+            assert_eq!(h.closed.command.q_des, before, "holds the last command");
+            assert_eq!(h.closed.command.mode, CommandMode::Hold);
         } else {
-            assert_eq!(h.controller.status().state, ControllerState::Executing);
+            assert_eq!(
+                h.closed.controller.status().state,
+                ControllerState::Executing
+            );
         }
     }
 }
@@ -266,10 +294,10 @@ fn the_base_roll_and_pitch_rates_keep_their_own_bound_through_a_walk() {
         "ARMAR-4 bounds its pelvis tilt rate below the base speed"
     );
     let mut h = started("armar4", false);
-    let mut previous = h.sim.measurement().base_orientation;
+    let mut previous = h.closed.sim.measurement().base_orientation;
     let mut fastest_tilt: f64 = 0.0;
     walk_to_done(&mut h, |h| {
-        let qp = h.controller.last_problem();
+        let qp = h.closed.controller.last_problem();
         for k in 0..6 {
             let bound = if k == 3 || k == 4 {
                 config.max_base_tilt_speed
@@ -283,7 +311,7 @@ fn the_base_roll_and_pitch_rates_keep_their_own_bound_through_a_walk() {
             );
         }
         // World-frame angular velocity of the simulated base over the tick: roll and pitch rate.
-        let orientation = h.sim.measurement().base_orientation;
+        let orientation = h.closed.sim.measurement().base_orientation;
         let omega = (orientation * previous.inverse()).scaled_axis() / h.dt;
         fastest_tilt = fastest_tilt.max(omega.x.abs()).max(omega.y.abs());
         previous = orientation;
@@ -319,8 +347,8 @@ fn walk_releasing_the_hand(h: &Harness) -> stance::PostProcessedSequence {
 fn hand_in_pelvis_frame(h: &Harness) -> nalgebra::Isometry3<f64> {
     let model = &h.robot.model;
     let mut kinematics = kinematics::kinematics::Kinematics::new(model);
-    kinematics.update(model, h.sim.configuration());
-    let pelvis = stance::geometry::planar_frame([kinematics.link_pose(h.robot.base_link)]);
+    kinematics.update(model, h.closed.sim.configuration());
+    let pelvis = kinematics::ground::planar_frame([kinematics.link_pose(h.robot.base_link)]);
     let hand = kinematics.frame_pose(model, h.robot.frame(EndEffector::LeftHand));
     pelvis.inverse() * hand
 }
@@ -336,7 +364,7 @@ fn a_released_hand_is_carried_with_the_pelvis_only_when_configured() {
         let mut at_release = None;
         let mut moved: f64 = 0.0;
         walk_to_done(&mut h, |h| {
-            if h.controller.status().stance_index >= 2 {
+            if h.closed.controller.status().stance_index >= 2 {
                 let relative = hand_in_pelvis_frame(h);
                 let first = *at_release.get_or_insert(relative);
                 let offset = relative.translation.vector - first.translation.vector;

@@ -1,12 +1,12 @@
 //! The controller walks without falling under rigid-body physics: `daemon::controller` in closed
-//! loop with MuJoCo (`walk_tests::physics`), 500 Hz control, 1 ms physics steps, measurement
+//! loop with MuJoCo (`walk_bench::physics`), 500 Hz control, 1 ms physics steps, measurement
 //! from the simulated FT sensors, joint encoders and IMU. Each test walks forward (1 m for every
 //! robot and affordance set, 5 m feet-only per robot) and requires `done` with no fall (base
 //! height, torso tilt), the feet on their final targets, and the controller's estimate close to
 //! the simulator's truth. The seeds are fixed; `walkctl evaluate --physics mujoco` runs the
 //! paper's ten-seed matrix over processes (docs/evaluation.md).
 //!
-//! Needs the `mujoco` feature of walk-tests (scripts/test.sh enables it). Built without it, the
+//! Needs the `mujoco` feature of walk-bench (scripts/test.sh enables it). Built without it, the
 //! single test below fails and says how to enable it: a physics check that compiled to nothing
 //! would otherwise pass silently.
 
@@ -14,8 +14,8 @@
 #[test]
 fn physics_walk_needs_the_mujoco_feature() {
     panic!(
-        "walk-tests was built without its `mujoco` feature, so the physics walks did not run: \
-         eval \"$(scripts/setup-mujoco.sh)\" and test with --features walk-tests/mujoco \
+        "walk-bench was built without its `mujoco` feature, so the physics walks did not run: \
+         eval \"$(scripts/setup-mujoco.sh)\" and test with --features walk-bench/mujoco \
          (scripts/test.sh does both)"
     );
 }
@@ -24,10 +24,16 @@ fn physics_walk_needs_the_mujoco_feature() {
 mod walks {
     use client::evaluate::write_fig6;
     use stance::AffordanceSet;
-    use walk_tests::config;
-    use walk_tests::physics::{
+    use walk_bench::physics::{
         PhysicsWalkOptions, PhysicsWalkReport, walk_distance, walk_sequence,
     };
+
+    /// `configs/<robot>.toml`.
+    fn config(robot: &str) -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../configs")
+            .join(format!("{robot}.toml"))
+    }
 
     /// The walk must end with each simulated sole this close to its final target (m). Each
     /// landing keeps the approach's residual error (within `position_tolerance_m`, 2 cm for
@@ -178,15 +184,14 @@ mod walks {
             AffordanceSet::FeetLeftHand,
             AffordanceSet::FeetRightHand,
         ] {
-            let sequence = daemon::bench::sequence::generated(
-                &robot_model,
-                params.clone(),
-                &source,
-                1.0,
+            let request = stance::WalkRequest {
+                distance: 1.0,
                 affordances,
-                0,
-            )
-            .expect("a learned sequence");
+                seed: 0,
+            };
+            let sequence =
+                walk_bench::sequence::generated(&robot_model, &params, &source, &request)
+                    .expect("a learned sequence");
             let report = walk_sequence(
                 robot_model.clone(),
                 controller,

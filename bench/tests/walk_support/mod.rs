@@ -2,16 +2,17 @@
 //! synthetic step-to walking sequence, and per-tick safety checks.
 #![allow(dead_code)]
 
+use kinematic_sim::Simulator;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use daemon::bench::{Outcome, TickObservation, WalkOptions, WalkReport, walk};
-use daemon::controller::{Command, Controller, ControllerConfig, Measurement, Phase, SolverKind};
+use daemon::controller::{Controller, ControllerConfig, Phase, SolverKind};
 use kinematic_sim::KinematicSim;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Translation3};
 use stance::{Environment, PostProcessedSequence, Stance};
+use walk_bench::{ClosedLoop, Outcome, TickObservation, WalkOptions, WalkReport, walk};
 
 /// Path of `configs/<name>.toml`.
 pub fn config_path(name: &str) -> PathBuf {
@@ -175,9 +176,7 @@ pub fn assert_walks_to_done(
 /// can tamper with the measurement.
 pub struct Harness {
     pub robot: Arc<Robot>,
-    pub controller: Controller,
-    pub sim: KinematicSim,
-    pub command: Command,
+    pub closed: ClosedLoop<KinematicSim>,
     pub dt: f64,
 }
 
@@ -192,13 +191,11 @@ impl Harness {
         let robot = robot(name);
         let controller = Controller::new(robot.clone(), config, SolverKind::Dense).unwrap();
         let sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
-        let command = Command::new(robot.model.dof());
+        let closed = ClosedLoop::new(controller, sim, rate_hz);
         Self {
+            dt: closed.dt(),
             robot,
-            controller,
-            sim,
-            command,
-            dt: 1.0 / rate_hz,
+            closed,
         }
     }
 
@@ -206,33 +203,15 @@ impl Harness {
     pub fn start(&mut self, sequence: &PostProcessedSequence) {
         let config = controller_config(&self.robot.name);
         let prepared = Controller::prepare(&self.robot, &config, sequence).unwrap();
-        assert!(self.controller.start(Box::new(prepared)).is_ok());
+        assert!(self.closed.controller.start(Box::new(prepared)).is_ok());
     }
 
     /// One tick: the measurement's wrenches pass through `tamper`, then the simulator applies
     /// the command.
     pub fn tick_with(&mut self, tamper: impl FnOnce(&mut [[f64; 6]; 4])) {
-        let m = self.sim.measurement();
-        let mut wrenches = m.wrenches;
-        tamper(&mut wrenches);
-        let measurement = Measurement {
-            q: m.q.as_slice(),
-            qd: m.qd.as_slice(),
-            wrenches: &wrenches,
-            imu_orientation: Some(m.base_orientation),
-        };
-        assert!(
-            self.controller
-                .tick(&measurement, self.dt, &mut self.command),
-            "the simulator's measurements are valid, so every tick commands"
-        );
-        self.sim
-            .step(
-                self.command.q_des.as_slice(),
-                self.command.qd_des.as_slice(),
-                self.dt,
-            )
-            .unwrap();
+        self.closed
+            .tick_with(tamper)
+            .expect("the simulator's measurements are valid, so every tick commands");
     }
 
     /// One untampered tick.
@@ -243,14 +222,14 @@ impl Harness {
     /// The command is finite and inside the joint limits; the simulator is safe.
     pub fn assert_safe(&self) {
         let limits = self.robot.model.joint_limits();
-        for (j, (q, limit)) in self.command.q_des.iter().zip(limits).enumerate() {
+        for (j, (q, limit)) in self.closed.command.q_des.iter().zip(limits).enumerate() {
             assert!(
                 q.is_finite() && *q >= limit.lower && *q <= limit.upper,
                 "joint {j}: q_des {q}"
             );
         }
-        assert!(self.command.qd_des.iter().all(|v| v.is_finite()));
-        let s = &self.sim.measurement().safety;
+        assert!(self.closed.command.qd_des.iter().all(|v| v.is_finite()));
+        let s = &self.closed.sim.measurement().safety;
         assert!(
             s.stability_margin >= 0.0,
             "stability margin {}",

@@ -5,6 +5,7 @@
 
 mod walk_support;
 
+use kinematic_sim::Simulator;
 use std::sync::Arc;
 
 use daemon::controller::{Command, Controller, Measurement, SolverKind};

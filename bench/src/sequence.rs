@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 
 use kinematics::robot::Robot;
 use stance::learned::{SourceError, StanceSource};
+use stance::walk::WalkError;
 use stance::{
-    AffordanceSet, FormatError, GenerateOptions, PostProcessParams, PostProcessedSequence,
-    PostProcessor, RawSequence,
+    FormatError, PostProcessParams, PostProcessedSequence, PostProcessor, RawSequence, WalkRequest,
 };
 
 /// Why no sequence could be produced; every variant names what is wrong. The message is
@@ -15,12 +15,9 @@ use stance::{
 /// print it once.
 #[derive(Debug, thiserror::Error)]
 pub enum SequenceError {
-    /// The stance source failed (bad model, distance or retargeting).
-    #[error("generating the stance sequence: {0}")]
-    Source(SourceError),
-    /// Algorithm 1 refused the raw sequence.
-    #[error("post-processing the stance sequence: {0}")]
-    PostProcess(FormatError),
+    /// The stance source or Algorithm 1 failed (bad model, distance, retargeting).
+    #[error("{0}")]
+    Walk(WalkError<SourceError>),
     /// The sequence file could not be read.
     #[error("{path}: {error}")]
     Read {
@@ -47,31 +44,16 @@ pub enum SequenceError {
     },
 }
 
-impl From<SourceError> for SequenceError {
-    fn from(error: SourceError) -> Self {
-        Self::Source(error)
-    }
-}
-
-/// Generates a sequence that covers `distance` metres after post-processing: the source is asked
-/// for `distance / scf` (the paper's rule), on flat ground without a railing.
+/// The walk of `request` from `source`, post-processed with `params` (see `stance::walk`).
 pub fn generated(
     robot: &Robot,
-    params: PostProcessParams,
+    params: &PostProcessParams,
     source: &StanceSource,
-    distance: f64,
-    affordances: AffordanceSet,
-    seed: u64,
+    request: &WalkRequest,
 ) -> Result<PostProcessedSequence, SequenceError> {
-    let options = GenerateOptions {
-        distance: distance / params.scf,
-        affordances,
-        seed,
-    };
-    let raw = source.generate(robot, &options, None)?.raw;
-    PostProcessor::new(robot, params)
-        .process(&raw)
-        .map_err(SequenceError::PostProcess)
+    source
+        .walk(robot, params, request)
+        .map_err(SequenceError::Walk)
 }
 
 /// Reads a stance file for `robot`: a post-processed one as written by `walkctl postprocess`,

@@ -10,11 +10,12 @@ mod walk_support;
 
 use std::path::{Path, PathBuf};
 
-use daemon::bench::sequence::{self, SequenceError};
 use daemon::controller::SolverKind;
 use kinematics::robot::EndEffector;
 use stance::learned::StanceSource;
-use stance::{AffordanceSet, PostProcessParams, PostProcessedSequence};
+use stance::walk::WalkError;
+use stance::{AffordanceSet, PostProcessParams, PostProcessedSequence, WalkRequest};
+use walk_bench::sequence::{self, SequenceError};
 
 /// Runs at 200 Hz to keep CI time down (`walkd bench` checks the 500 Hz default).
 const RATE_HZ: f64 = 200.0;
@@ -37,15 +38,13 @@ fn learned_sequence(
 ) -> PostProcessedSequence {
     let robot = walk_support::robot(robot_name);
     let source = StanceSource::learned(&default_model(), beam).expect("default model loads");
-    sequence::generated(
-        &robot,
-        params(robot_name),
-        &source,
+    let request = WalkRequest {
         distance,
         affordances,
         seed,
-    )
-    .expect("learned sequence is generated and post-processed")
+    };
+    sequence::generated(&robot, &params(robot_name), &source, &request)
+        .expect("learned sequence is generated and post-processed")
 }
 
 /// Stances in which `hand` supports.
@@ -131,11 +130,12 @@ fn read(robot_name: &str, path: &Path, postprocess: bool) -> Result<PostProcesse
 fn sequence_files_read_back_as_generated() {
     let robot = walk_support::robot("jvrc1");
     let source = StanceSource::learned(&default_model(), None).unwrap();
-    let options = stance::GenerateOptions {
-        distance: 1.0 / params("jvrc1").scf,
+    let request = WalkRequest {
+        distance: 1.0,
         affordances: AffordanceSet::FeetLeftHand,
         seed: 1,
     };
+    let options = request.generate_options(&params("jvrc1"));
     let raw = source.generate(&robot, &options, None).unwrap().raw;
     let expected = learned_sequence("jvrc1", AffordanceSet::FeetLeftHand, 1.0, None, 1);
 
@@ -187,6 +187,6 @@ fn a_bad_model_file_is_named() {
     std::fs::write(&path, "{\"version\": 1, \"order\": }").unwrap();
     let result = StanceSource::learned(&path, None);
     std::fs::remove_file(&path).unwrap();
-    let error = SequenceError::from(result.unwrap_err()).to_string();
+    let error = SequenceError::Walk(WalkError::Source(result.unwrap_err())).to_string();
     assert!(error.contains(&path.display().to_string()), "{error}");
 }

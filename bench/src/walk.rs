@@ -1,17 +1,18 @@
-//! The in-process closed loop: controller ↔ kinematic simulator, as fast as possible, with the
-//! tick duration timed around `Controller::tick` (outside the controller core).
+//! A walk to its end against the kinematic simulator, as fast as the machine runs: the closed
+//! loop ([`ClosedLoop`]) until `done`, a fault, a fall (the simulated CoM left the support
+//! polygon) or the time limit.
 
+use kinematic_sim::Simulator;
 use std::sync::Arc;
-use std::time::Instant;
 
+use daemon::controller::{
+    Command, Controller, ControllerConfig, ControllerState, ControllerStatus, SolverKind,
+};
 use kinematic_sim::{KinematicSim, SafetySummary, SimMeasurement};
-use kinematics::robot::{EndEffector, Robot};
+use kinematics::robot::Robot;
 use stance::PostProcessedSequence;
 
-use crate::controller::{
-    Command, Controller, ControllerConfig, ControllerState, ControllerStatus, Measurement,
-    SolverKind,
-};
+use crate::closed_loop::{ClosedLoop, TickError, feet_midpoint};
 
 /// How to run a walk.
 #[derive(Clone, Copy, Debug)]
@@ -46,7 +47,7 @@ pub enum Outcome {
     /// The controller reached `Done`.
     Done,
     /// The controller faulted; the code names why.
-    Fault(crate::controller::FaultCode),
+    Fault(daemon::controller::FaultCode),
     /// The simulated CoM left the support polygon.
     Fell,
     /// The simulated time limit passed first.
@@ -54,7 +55,7 @@ pub enum Outcome {
 }
 
 impl Outcome {
-    /// `done` or `fault:<reason>` as printed by `walkd bench`.
+    /// `done` or `fault:<reason>` as printed by `walk-bench`.
     pub fn label(self) -> String {
         match self {
             Self::Done => "done".to_owned(),
@@ -80,24 +81,18 @@ pub struct WalkReport {
     pub distance_m: f64,
 }
 
-/// Errors setting up a walk.
+/// Errors setting up or running a walk.
 #[derive(Debug, thiserror::Error)]
 pub enum WalkError {
     /// The controller could not be built.
     #[error(transparent)]
-    Controller(#[from] crate::controller::ControllerError),
+    Controller(#[from] daemon::controller::ControllerError),
     /// The controller refused the sequence.
     #[error(transparent)]
-    Refused(#[from] crate::controller::Refusal),
-    /// The simulator refused the start state or a command.
-    #[error("simulator: {0}")]
-    Sim(kinematic_sim::SimError),
-}
-
-impl From<kinematic_sim::SimError> for WalkError {
-    fn from(error: kinematic_sim::SimError) -> Self {
-        Self::Sim(error)
-    }
+    Refused(#[from] daemon::controller::Refusal),
+    /// The simulator refused the start state or a command, or the controller wrote none.
+    #[error("{0}")]
+    Loop(String),
 }
 
 /// Executes `sequence` on `robot` (starting from its standing posture) in closed loop with the
@@ -111,14 +106,13 @@ pub fn walk(
 ) -> Result<WalkReport, WalkError> {
     let prepared = Controller::prepare(&robot, &config, sequence)?;
     let stances = prepared.len();
-    let mut controller = Controller::new(robot.clone(), config, options.solver)?;
-    let mut sim = KinematicSim::new(robot.clone(), robot.standing.clone())?;
-    let dof = robot.model.dof();
-    let mut command = Command::new(dof);
-    let dt = 1.0 / options.rate_hz;
+    let controller = Controller::new(robot.clone(), config, options.solver)?;
+    let sim = KinematicSim::new(robot.clone(), robot.standing.clone())
+        .map_err(|e| WalkError::Loop(format!("simulator: {e}")))?;
+    let mut closed = ClosedLoop::new(controller, sim, options.rate_hz);
     let max_ticks = (options.time_limit_s * options.rate_hz).ceil() as u64;
-    let start_midpoint = feet_midpoint(&sim);
-    if controller.start(Box::new(prepared)).is_err() {
+    let start_midpoint = feet_midpoint(&closed.sim);
+    if closed.controller.start(Box::new(prepared)).is_err() {
         unreachable!("a new controller accepts a sequence");
     }
     let mut ticks = 0;
@@ -126,60 +120,34 @@ pub fn walk(
         if ticks >= max_ticks {
             break Outcome::TimeLimit;
         }
-        let m = sim.measurement();
-        let measurement = Measurement {
-            q: m.q.as_slice(),
-            qd: m.qd.as_slice(),
-            wrenches: &m.wrenches,
-            imu_orientation: Some(m.base_orientation),
+        let compute = match closed.tick() {
+            Ok(compute) => compute,
+            Err(TickError::NoCommand) => break Outcome::Fault(closed.controller.status().fault),
+            Err(error) => return Err(WalkError::Loop(error.to_string())),
         };
-        let started = Instant::now();
-        let commanded = controller.tick(&measurement, dt, &mut command);
-        let tick_ns = started.elapsed().as_nanos() as u64;
-        if !commanded {
-            // Only before a first valid measurement: the simulator's never is invalid.
-            break Outcome::Fault(controller.status().fault);
-        }
-        sim.step(command.q_des.as_slice(), command.qd_des.as_slice(), dt)?;
         observe(&TickObservation {
             tick: ticks,
-            sim: sim.measurement(),
-            status: controller.status(),
-            command: &command,
-            controller: &controller,
-            tick_ns,
+            sim: closed.sim.measurement(),
+            status: closed.controller.status(),
+            command: &closed.command,
+            controller: &closed.controller,
+            tick_ns: compute.as_nanos() as u64,
         });
         ticks += 1;
-        if sim.measurement().safety.stability_margin < 0.0 {
+        if closed.sim.measurement().safety.stability_margin < 0.0 {
             break Outcome::Fell;
         }
-        match controller.status().state {
+        match closed.controller.status().state {
             ControllerState::Done => break Outcome::Done,
-            ControllerState::Fault => break Outcome::Fault(controller.status().fault),
+            ControllerState::Fault => break Outcome::Fault(closed.controller.status().fault),
             _ => {}
         }
     };
-    let end_midpoint = feet_midpoint(&sim);
     Ok(WalkReport {
         outcome,
         stances,
         ticks,
-        safety: *sim.summary(),
-        distance_m: (end_midpoint - start_midpoint).norm(),
+        safety: *closed.sim.summary(),
+        distance_m: (feet_midpoint(&closed.sim) - start_midpoint).norm(),
     })
-}
-
-/// Ground-plane midpoint of the two soles (simulator truth).
-fn feet_midpoint(sim: &KinematicSim) -> nalgebra::Vector2<f64> {
-    let robot = sim.robot();
-    let mut kinematics = kinematics::kinematics::Kinematics::new(&robot.model);
-    kinematics.update(&robot.model, sim.configuration());
-    let pose = |e: EndEffector| {
-        kinematics
-            .frame_pose(&robot.model, robot.frame(e))
-            .translation
-            .vector
-            .xy()
-    };
-    (pose(EndEffector::LeftFoot) + pose(EndEffector::RightFoot)) / 2.0
 }

@@ -13,22 +13,25 @@
 //! simulator's truth (CoM and soles), and a time trace of target vs controller vs simulator for
 //! the paper's Fig. 6.
 
+use kinematic_sim::Simulator;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use client::evaluate::{Points, TraceSample, align_targets, stance_points};
-use daemon::bench::sequence::generated;
 use daemon::controller::{
-    Command, Controller, ControllerConfig, ControllerState, ControllerStatus, FaultCode,
-    Measurement, SolverKind,
+    Controller, ControllerConfig, ControllerState, ControllerStatus, FaultCode, SolverKind,
 };
+use kinematics::ConfigFile;
 use kinematics::robot::{EndEffector, Robot};
 use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim};
-use stance::learned::StanceSource;
 use stance::poses::FEET;
-use stance::{AffordanceSet, PostProcessParams, PostProcessedSequence};
+use stance::{
+    AffordanceSet, PostProcessParams, PostProcessedSequence, WalkRequest, synthetic_walk,
+};
+
+use crate::closed_loop::{ClosedLoop, TickError, feet_midpoint};
 
 /// How to run a physics walk.
 #[derive(Clone, Copy, Debug)]
@@ -168,20 +171,18 @@ pub fn walk_distance(
     seed: u64,
     options: &PhysicsWalkOptions,
 ) -> anyhow::Result<PhysicsWalkReport> {
+    let file = ConfigFile::load(config)?;
     let robot = Arc::new(
-        Robot::load(config, urdf).with_context(|| format!("loading {}", config.display()))?,
+        Robot::from_config(&file, urdf).with_context(|| format!("loading {}", config.display()))?,
     );
-    let params = PostProcessParams::from_config_path(config)?;
-    let controller_config = ControllerConfig::from_config_file(config)?;
-    let sequence = generated(
-        &robot,
-        params,
-        &StanceSource::Synthetic,
+    let params = PostProcessParams::from_config(&file)?;
+    let controller_config = ControllerConfig::from_config(&file)?;
+    let request = WalkRequest {
         distance,
         affordances,
         seed,
-    )
-    .context("generating and post-processing the stance sequence")?;
+    };
+    let sequence = synthetic_walk(&robot, &params, &request)?;
     walk_sequence(robot, controller_config, &sequence, options)
 }
 
@@ -200,26 +201,25 @@ pub fn walk_sequence(
     let prepared = Controller::prepare(&robot, &config, sequence)
         .map_err(|refusal| anyhow::anyhow!("the controller refused the sequence: {refusal}"))?;
     let mut targets = stance_points(&robot, sequence);
-    let mut controller = Controller::new(robot.clone(), config, options.solver)?;
-    let mut sim = MujocoSim::new(robot.clone(), &robot.urdf, &robot.standing, options.mujoco)
+    let controller = Controller::new(robot.clone(), config, options.solver)?;
+    let sim = MujocoSim::new(robot.clone(), &robot.urdf, &robot.standing, options.mujoco)
         .context("building the MuJoCo model")?;
-    if controller.start(Box::new(prepared)).is_err() {
+    let mut closed = ClosedLoop::new(controller, sim, options.rate_hz);
+    if closed.controller.start(Box::new(prepared)).is_err() {
         anyhow::bail!("a new controller refused to start");
     }
-    let dt = 1.0 / options.rate_hz;
     let time_limit = options
         .time_limit_s
         .unwrap_or(60.0 + 20.0 * sequence.len() as f64);
     let max_ticks = (time_limit * options.rate_hz).ceil() as u64;
     let settle_ticks = (options.settle_s * options.rate_hz).ceil() as u64;
-    let mut command = Command::new(robot.model.dof());
-    let start_midpoint = feet_midpoint(&sim);
+    let start_midpoint = feet_midpoint(&closed.sim);
     align_targets(
         &mut targets,
         sequence,
-        &FEET.map(|f| sim.end_effector_pose(f)),
+        &FEET.map(|f| closed.sim.end_effector_pose(f)),
     );
-    let initial_height = sim.base_height();
+    let initial_height = closed.sim.base_height();
     let mut loop_state = LoopState {
         trace: Vec::with_capacity((max_ticks / options.trace_every.max(1)).min(1 << 20) as usize),
         max_com_drift: 0.0,
@@ -236,19 +236,19 @@ pub fn walk_sequence(
         if ticks >= max_ticks {
             break PhysicsOutcome::TimeLimit;
         }
-        if let Err(outcome) = loop_state.tick(&mut controller, &mut sim, &mut command, dt) {
+        if let Err(outcome) = loop_state.tick(&mut closed) {
             break outcome;
         }
         ticks += 1;
-        let status = controller.status();
-        loop_state.observe(&sim, status);
+        let (sim, status) = (&closed.sim, closed.controller.status());
+        loop_state.observe(sim, status);
         if options.trace_every > 0 && ticks % options.trace_every == 0 {
             let sample = TraceSample {
                 t: sim.time(),
                 stance_index: status.stance_index,
                 target: targets[(status.stance_index as usize).min(targets.len() - 1)],
                 controller: controller_points(status),
-                sim: Some(sim_points(&sim)),
+                sim: Some(sim_points(sim)),
             };
             loop_state.trace.push(sample);
         }
@@ -261,30 +261,32 @@ pub fn walk_sequence(
             _ => {}
         }
     };
-    let sim_s = sim.time();
-    let end_drift = sim_points(&sim).distances(&controller_points(controller.status()));
+    let sim_s = closed.sim.time();
+    let end_drift =
+        sim_points(&closed.sim).distances(&controller_points(closed.controller.status()));
     if outcome == PhysicsOutcome::Done {
         for _ in 0..settle_ticks {
-            if let Err(o) = loop_state.tick(&mut controller, &mut sim, &mut command, dt) {
+            if let Err(o) = loop_state.tick(&mut closed) {
                 outcome = o;
                 break;
             }
-            loop_state.observe(&sim, controller.status());
-            if sim.has_fallen() {
-                outcome = PhysicsOutcome::Fell { at_s: sim.time() };
+            loop_state.observe(&closed.sim, closed.controller.status());
+            if closed.sim.has_fallen() {
+                outcome = PhysicsOutcome::Fell {
+                    at_s: closed.sim.time(),
+                };
                 break;
             }
         }
     }
     let wall_s = wall.elapsed().as_secs_f64();
+    let sim = &closed.sim;
     let last = targets[targets.len() - 1];
-    let end = sim_points(&sim);
-    let final_position_error_m = end.distances(&last).1;
-    let summary = sim.summary();
+    let final_position_error_m = sim_points(sim).distances(&last).1;
     Ok(PhysicsWalkReport {
         outcome,
         stances: sequence.len(),
-        stance_reached: controller.status().stance_index,
+        stance_reached: closed.controller.status().stance_index,
         ticks,
         sim_s,
         wall_s,
@@ -295,8 +297,8 @@ pub fn walk_sequence(
         max_com_drift_m: loop_state.max_com_drift,
         max_foot_drift_m: loop_state.max_foot_drift,
         final_drift_m: end_drift,
-        distance_m: (feet_midpoint(&sim) - start_midpoint).norm(),
-        max_contact_slip_m: summary.max_contact_slip,
+        distance_m: (feet_midpoint(sim) - start_midpoint).norm(),
+        max_contact_slip_m: sim.summary().max_contact_slip,
         min_stability_margin_m: loop_state.min_margin,
         max_tilt_rad: loop_state.max_tilt,
         min_base_height_ratio: loop_state.min_height / initial_height,
@@ -317,36 +319,27 @@ struct LoopState {
 }
 
 impl LoopState {
-    /// One control tick: measure, control, step the physics by `dt`.
-    fn tick(
-        &mut self,
-        controller: &mut Controller,
-        sim: &mut MujocoSim,
-        command: &mut Command,
-        dt: f64,
-    ) -> Result<(), PhysicsOutcome> {
-        let m = sim.measurement();
-        let measurement = Measurement {
-            q: m.q.as_slice(),
-            qd: m.qd.as_slice(),
-            wrenches: &m.wrenches,
-            imu_orientation: Some(m.base_orientation),
-        };
+    /// One control tick of the closed loop, its controller and physics time accounted.
+    fn tick(&mut self, closed: &mut ClosedLoop<MujocoSim>) -> Result<(), PhysicsOutcome> {
         let started = Instant::now();
-        let commanded = controller.tick(&measurement, dt, command);
-        let stepped = Instant::now();
-        if !commanded {
-            // Only before a first valid measurement: the simulator's never is invalid.
-            return Err(PhysicsOutcome::Fault(controller.status().fault));
-        }
-        let result = sim.step(command.q_des.as_slice(), command.qd_des.as_slice(), dt);
-        self.physics_time += stepped.elapsed();
-        self.controller_time += stepped - started;
+        let result = closed.tick();
+        let total = started.elapsed();
         match result {
-            Ok(()) => Ok(()),
-            Err(MujocoError::Unstable { time }) => Err(PhysicsOutcome::Unstable { at_s: time }),
+            Ok(compute) => {
+                self.controller_time += compute;
+                self.physics_time += total.saturating_sub(compute);
+                Ok(())
+            }
+            Err(TickError::Sim(MujocoError::Unstable { time })) => {
+                Err(PhysicsOutcome::Unstable { at_s: time })
+            }
+            Err(TickError::NoCommand) => {
+                Err(PhysicsOutcome::Fault(closed.controller.status().fault))
+            }
             // Commands are always finite, in-limit and sized by the controller's contract.
-            Err(error) => panic!("the simulator refused a controller command: {error}"),
+            Err(TickError::Sim(error)) => {
+                panic!("the simulator refused a controller command: {error}")
+            }
         }
     }
 
@@ -380,9 +373,4 @@ fn sim_points(sim: &MujocoSim) -> Points {
             .translation
             .vector,
     }
-}
-
-fn feet_midpoint(sim: &MujocoSim) -> nalgebra::Vector2<f64> {
-    let p = sim_points(sim);
-    (p.left_foot.xy() + p.right_foot.xy()) / 2.0
 }

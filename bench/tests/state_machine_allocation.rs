@@ -2,6 +2,7 @@
 
 mod walk_support;
 
+use kinematic_sim::Simulator;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -42,8 +43,8 @@ fn controller_tick_does_not_allocate() {
         h.start(&sequence);
         let mut ticks = 0;
         let mut allocations = 0;
-        while h.controller.status().state != ControllerState::Done && ticks < 20_000 {
-            let m = h.sim.measurement();
+        while h.closed.controller.status().state != ControllerState::Done && ticks < 20_000 {
+            let m = h.closed.sim.measurement();
             let measurement = Measurement {
                 q: m.q.as_slice(),
                 qd: m.qd.as_slice(),
@@ -52,21 +53,25 @@ fn controller_tick_does_not_allocate() {
             };
             ALLOCATIONS.store(0, Ordering::Relaxed);
             COUNTING.store(true, Ordering::Relaxed);
-            let commanded = h.controller.tick(&measurement, h.dt, &mut h.command);
+            let commanded = h
+                .closed
+                .controller
+                .tick(&measurement, h.dt, &mut h.closed.command);
             COUNTING.store(false, Ordering::Relaxed);
             allocations += ALLOCATIONS.load(Ordering::Relaxed);
             assert!(commanded, "{robot}: the simulator's measurements are valid");
-            h.sim
+            h.closed
+                .sim
                 .step(
-                    h.command.q_des.as_slice(),
-                    h.command.qd_des.as_slice(),
+                    h.closed.command.q_des.as_slice(),
+                    h.closed.command.qd_des.as_slice(),
                     h.dt,
                 )
                 .unwrap();
             ticks += 1;
         }
         assert_eq!(
-            h.controller.status().state,
+            h.closed.controller.status().state,
             ControllerState::Done,
             "{robot}"
         );

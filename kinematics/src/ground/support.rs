@@ -4,7 +4,7 @@
 //! constraint), so both judge static stability with the same geometry. Fixed capacity, no
 //! allocation: it is used on the real-time path.
 
-use kinematics::robot::SoleRectangle;
+use crate::robot::SoleRectangle;
 use nalgebra::{Isometry3, Point3, Vector3};
 
 /// Most points a support polygon is built from (four corners for each of four end-effectors).

@@ -5,24 +5,22 @@
 
 mod walk_support;
 
-use daemon::bench::sequence::generated;
 use daemon::controller::SolverKind;
 use stance::learned::StanceSource;
-use stance::{AffordanceSet, PostProcessParams};
+use stance::{AffordanceSet, PostProcessParams, WalkRequest};
+use walk_bench::sequence::generated;
 
 fn generated_walk(robot_name: &str, affordances: AffordanceSet, distance: f64, solver: SolverKind) {
     let robot = walk_support::robot(robot_name);
     let params =
         PostProcessParams::from_config_path(&walk_support::config_path(robot_name)).unwrap();
-    let sequence = generated(
-        &robot,
-        params,
-        &StanceSource::Synthetic,
+    let request = WalkRequest {
         distance,
         affordances,
-        0,
-    )
-    .expect("generation and post-processing run");
+        seed: 0,
+    };
+    let sequence = generated(&robot, &params, &StanceSource::Synthetic, &request)
+        .expect("generation and post-processing run");
     let label = format!("{robot_name} {affordances} {distance} m {solver:?}");
     walk_support::assert_walks_to_done(robot_name, &sequence, solver, 200.0, distance, &label);
 }

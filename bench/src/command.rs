@@ -1,4 +1,4 @@
-//! `walkd bench`: generate (synthetic or learned source) and post-process a walk, or read one
+//! `walk-bench`: generate (synthetic or learned source) and post-process a walk, or read one
 //! from a stance file, execute it in-process against the kinematic simulator, as fast as
 //! possible, and report outcome, safety and timing.
 //!
@@ -6,24 +6,23 @@
 //! `Controller::tick`, and the QP time by re-solving each tick's QP (the controller's
 //! `last_problem`) with a second solver of the same kind, warm-started the same way.
 
-pub mod sequence;
-mod walk;
-
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
+use daemon::controller::{Controller, ControllerConfig, ControllerState, SolverKind};
+use daemon::qp::{ClarabelSolver, DenseActiveSetSolver, QpSolver, export_json};
 use hdrhistogram::Histogram;
+use kinematics::ConfigFile;
 use kinematics::robot::Robot;
+use shm_types::RuntimeConfig;
 use stance::learned::SourceArgs;
-use stance::{AffordanceSet, PostProcessParams, PostProcessedSequence};
+use stance::{AffordanceSet, PostProcessParams, PostProcessedSequence, WalkRequest};
 
-use crate::controller::{ControllerConfig, ControllerState, SolverKind};
-use crate::qp::{ClarabelSolver, DenseActiveSetSolver, QpSolver, export_json};
-
-pub use walk::{Outcome, TickObservation, WalkError, WalkOptions, WalkReport, walk};
+use crate::sequence;
+use crate::walk::{Outcome, WalkOptions, WalkReport, walk};
 
 /// Control rate when neither `--rate-hz` nor `[runtime] rate_hz` gives one (Hz).
 const DEFAULT_RATE_HZ: f64 = 500.0;
@@ -50,7 +49,7 @@ impl From<SolverArg> for SolverKind {
     }
 }
 
-/// Arguments of `walkd bench`.
+/// Arguments of `walk-bench`.
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
     /// Robot config (TOML with [robot], [postprocess], [controller], [runtime]).
@@ -95,13 +94,13 @@ pub struct BenchArgs {
     pub export_qp: Option<PathBuf>,
 }
 
-/// Runs `walkd bench`: exit 0 when the walk reached `done`, 1 when it did not, 2 on bad input.
+/// Runs `walk-bench`: exit 0 when the walk reached `done`, 1 when it did not, 2 on bad input.
 pub fn main(args: &BenchArgs) -> ExitCode {
     match run(args) {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(error) => {
-            eprintln!("walkd bench: {error:#}");
+            eprintln!("walk-bench: {error:#}");
             ExitCode::from(2)
         }
     }
@@ -123,15 +122,19 @@ impl Timing {
 }
 
 fn run(args: &BenchArgs) -> anyhow::Result<bool> {
+    let file = ConfigFile::load(&args.robot)?;
     let robot = Arc::new(
-        Robot::load(&args.robot, args.urdf.as_deref())
+        Robot::from_config(&file, args.urdf.as_deref())
             .with_context(|| format!("loading robot {}", args.robot.display()))?,
     );
-    let params = PostProcessParams::from_config_path(&args.robot)?;
-    let config = ControllerConfig::from_config_file(&args.robot)?;
-    let rate_hz = match args.rate_hz {
-        Some(rate) => rate,
-        None => runtime_rate(&args.robot)?.unwrap_or(DEFAULT_RATE_HZ),
+    let params = PostProcessParams::from_config(&file)?;
+    let config = ControllerConfig::from_config(&file)?;
+    let rate_hz = match (args.rate_hz, file.section("runtime")) {
+        (Some(rate), _) => rate,
+        (None, Some(section)) => {
+            RuntimeConfig::from_section(Some(section), &file.origin())?.rate_hz
+        }
+        (None, None) => DEFAULT_RATE_HZ,
     };
     anyhow::ensure!(
         rate_hz.is_finite() && rate_hz > 0.0,
@@ -148,7 +151,7 @@ fn run(args: &BenchArgs) -> anyhow::Result<bool> {
     let mut timing_solver: Box<dyn QpSolver> = match solver_kind {
         SolverKind::Dense => {
             let n = robot.model.nv();
-            let p = crate::controller::Controller::qp_capacity();
+            let p = Controller::qp_capacity();
             Box::new(DenseActiveSetSolver::new(n, p.0, p.1))
         }
         SolverKind::Clarabel => Box::new(ClarabelSolver::new()),
@@ -210,14 +213,12 @@ fn bench_sequence(
                 "--distance {distance}: must be a positive number of metres"
             );
             let source = args.source.load()?;
-            let generated = sequence::generated(
-                robot,
-                params,
-                &source,
+            let request = WalkRequest {
                 distance,
-                args.affordances,
-                args.seed,
-            )?;
+                affordances: args.affordances,
+                seed: args.seed,
+            };
+            let generated = sequence::generated(robot, &params, &source, &request)?;
             let origin = format!(
                 "{distance} m requested, affordances {}, source {}",
                 args.affordances,
@@ -227,19 +228,6 @@ fn bench_sequence(
         }
         (None, None) => anyhow::bail!("give --distance D or --sequence FILE"),
     })
-}
-
-/// `[runtime] rate_hz` of the config, if set.
-fn runtime_rate(path: &Path) -> anyhow::Result<Option<f64>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let table: toml::Table = text
-        .parse()
-        .with_context(|| format!("parsing {}", path.display()))?;
-    Ok(table
-        .get("runtime")
-        .and_then(|r| r.get("rate_hz"))
-        .and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64))))
 }
 
 fn micros(h: &Histogram<u64>, quantile: f64) -> f64 {
@@ -310,12 +298,12 @@ fn print_report(
         };
         match serde_json::to_string(&value) {
             Ok(line) => println!("{line}"),
-            Err(error) => eprintln!("walkd bench: cannot write the JSON report: {error}"),
+            Err(error) => eprintln!("walk-bench: cannot write the JSON report: {error}"),
         }
         return;
     }
     println!(
-        "walkd bench: {} ({}), {origin}, solver {}, {} Hz",
+        "walk-bench: {} ({}), {origin}, solver {}, {} Hz",
         robot.name,
         args.robot.display(),
         solver.name(),

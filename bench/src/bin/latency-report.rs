@@ -13,17 +13,19 @@
 //!     [--loads idle,busy] [--spin-us N] [--fifo-priority 80]
 //! ```
 
-use std::fs::File;
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use clap::Parser;
+use client::process::{Launch, Process, Processes, executable_dir};
+use kinematics::ConfigFile;
 use kinematics::robot::Robot;
+use shm_types::process::Physics;
 use shm_types::{
-    ClientPorts, ControlCommand, DaemonStatus, HISTOGRAM_BUCKETS, LinkState, LogHistogram,
-    ServiceNames,
+    ClientPorts, ClockMode, ControlCommand, DaemonStatus, HISTOGRAM_BUCKETS, LinkState,
+    LogHistogram, ServiceNames,
 };
 
 /// Measure walkd's real-time behaviour under idle and loaded conditions.
@@ -86,83 +88,23 @@ struct Measurement {
     walkd_cpu_percent: f64,
 }
 
-/// Child processes, killed when dropped.
-struct Children(Vec<Child>);
-
-impl Children {
-    fn terminate(&mut self) {
-        for child in &self.0 {
-            // SAFETY: kill on our own child's pid has no memory-safety preconditions.
-            unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
-        }
-        for child in &mut self.0 {
-            let start = Instant::now();
-            while matches!(child.try_wait(), Ok(None)) && start.elapsed() < Duration::from_secs(5) {
-                std::thread::sleep(Duration::from_millis(10));
-            }
-            let _ = child.kill();
-            let _ = child.wait();
-        }
-        self.0.clear();
-    }
-}
-
-impl Drop for Children {
-    fn drop(&mut self) {
-        self.terminate();
-    }
-}
-
-fn sibling(name: &str) -> anyhow::Result<PathBuf> {
-    let path = std::env::current_exe()?
-        .parent()
-        .context("executable has no directory")?
-        .join(name);
-    anyhow::ensure!(
-        path.is_file(),
-        "{} missing: cargo build --release --bins",
-        path.display()
-    );
-    Ok(path)
-}
-
-fn spawn(path: &Path, args: &[String], stderr: Stdio) -> anyhow::Result<Child> {
-    Command::new(path)
-        .args(args)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(stderr)
-        .spawn()
-        .with_context(|| format!("cannot start {}", path.display()))
-}
-
 /// One busy-loop process per core.
-fn start_load() -> anyhow::Result<Children> {
+fn start_load() -> anyhow::Result<Processes> {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let me = std::env::current_exe()?;
-    let mut load = Children(Vec::new());
+    let mut load = Processes::default();
     for _ in 0..cores {
-        load.0
-            .push(spawn(&me, &["--burn".to_owned()], Stdio::null())?);
+        load.0.push(Process::start(&me, ["--burn"], &[])?);
     }
     Ok(load)
 }
 
 /// A long post-processed walk for the robot (so it walks during the whole run).
 fn long_walk(config: &Path) -> anyhow::Result<String> {
-    let robot = Robot::load(config, None)?;
-    let params = stance::PostProcessParams::from_config_path(config)?;
-    let raw = stance::generate(
-        &robot,
-        &stance::GenerateOptions {
-            distance: 20.0 / params.scf,
-            affordances: stance::AffordanceSet::Feet,
-            seed: 7,
-        },
-    )?;
-    Ok(stance::PostProcessor::new(&robot, params)
-        .process(&raw)?
-        .to_json_string())
+    let file = ConfigFile::load(config)?;
+    let robot = Robot::from_config(&file, None)?;
+    let (json, _) = client::demo::walk_sequence(&robot, &file, 20.0, 7)?;
+    Ok(json)
 }
 
 /// walkd's log lines about its timing (see `daemon::runtime`), without the timestamp.
@@ -179,26 +121,22 @@ fn timing_lines(log: &str) -> Vec<String> {
 
 /// Runs walkd + walk-sim at `rate_hz` for `seconds` and returns what the daemon measured.
 fn measure(args: &Args, walk: &str, rate_hz: f64, load: Load) -> anyhow::Result<Measurement> {
-    let prefix = format!("walk-latency/{}/{}", std::process::id(), rate_hz as u64);
-    let common = vec![
-        "--config".to_owned(),
-        args.config.display().to_string(),
-        "--service-prefix".to_owned(),
-        prefix.clone(),
-        "--clock".to_owned(),
-        "realtime".to_owned(),
-        "--rate-hz".to_owned(),
-        rate_hz.to_string(),
-    ];
-    let mut walkd_args = common.clone();
+    let launch = Launch {
+        bin_dir: executable_dir()?,
+        config: args.config.clone(),
+        prefix: format!("walk-latency/{}/{}", std::process::id(), rate_hz as u64),
+        clock: ClockMode::Realtime,
+        rate_hz: Some(rate_hz),
+        urdf: None,
+    };
+    let prefix = launch.prefix.clone();
+    let mut walkd_args = Vec::new();
     if let Some(priority) = args.fifo_priority {
         walkd_args.extend(["--fifo-priority".to_owned(), priority.to_string()]);
     }
     if let Some(spin_us) = args.spin_us {
         walkd_args.extend(["--spin-us".to_owned(), spin_us.to_string()]);
     }
-    let mut sim_args = common;
-    sim_args.extend(["--physics".to_owned(), "kinematic".to_owned()]);
     let load_average = std::fs::read_to_string("/proc/loadavg")
         .ok()
         .and_then(|text| text.split_whitespace().next().map(str::to_owned))
@@ -207,28 +145,21 @@ fn measure(args: &Args, walk: &str, rate_hz: f64, load: Load) -> anyhow::Result<
         Load::Idle => None,
         Load::Busy => Some(start_load()?),
     };
-    let log_path = std::env::temp_dir().join(format!(
-        "latency-report-{}-{}-{}.log",
-        std::process::id(),
-        rate_hz as u64,
-        load.describe().replace(' ', "-")
-    ));
-    let log =
-        File::create(&log_path).with_context(|| format!("cannot create {}", log_path.display()))?;
-    let mut system = Children(vec![spawn(
-        &sibling("walkd")?,
-        &walkd_args,
-        Stdio::from(log),
-    )?]);
-    let sim = sibling("walk-sim")?;
+    let walkd_args: Vec<&str> = walkd_args.iter().map(String::as_str).collect();
+    let walkd = launch.walkd(&walkd_args, &[])?;
+    let walkd_pid = walkd.pid();
+    let mut system = Processes(vec![walkd]);
+    let sim = launch.walk_sim_args(Physics::Kinematic);
     system.0.push(match args.fifo_priority {
+        // A real-time adapter: one priority below walkd's control thread.
         Some(priority) => {
-            let mut chrt_args = vec!["-f".to_owned(), (priority - 1).max(1).to_string()];
-            chrt_args.push(sim.display().to_string());
-            chrt_args.extend(sim_args);
-            spawn(Path::new("chrt"), &chrt_args, Stdio::null())?
+            let mut chrt_args: Vec<OsString> =
+                vec!["-f".into(), (priority - 1).max(1).to_string().into()];
+            chrt_args.push(launch.bin_dir.join("walk-sim").into());
+            chrt_args.extend(sim);
+            Process::start(Path::new("chrt"), chrt_args, &[])?
         }
-        None => spawn(&sim, &sim_args, Stdio::null())?,
+        None => launch.walk_sim(Physics::Kinematic)?,
     });
 
     let names = ServiceNames::new(&prefix)?;
@@ -250,7 +181,6 @@ fn measure(args: &Args, walk: &str, rate_hz: f64, load: Load) -> anyhow::Result<
         .submit(walk.as_bytes(), Duration::from_secs(10))?
         .accepted
         .is_set();
-    let walkd_pid = system.0[0].id();
     let (cpu_start, wall_start) = (cpu_seconds(walkd_pid)?, Instant::now());
     std::thread::sleep(Duration::from_secs(args.seconds));
     let walkd_cpu_percent =
@@ -258,10 +188,8 @@ fn measure(args: &Args, walk: &str, rate_hz: f64, load: Load) -> anyhow::Result<
     let status = client
         .control(ControlCommand::Query, Duration::from_secs(5))?
         .status;
-    system.terminate();
-    let log = std::fs::read_to_string(&log_path)
-        .with_context(|| format!("cannot read walkd's log {}", log_path.display()))?;
-    let _ = std::fs::remove_file(&log_path);
+    system.0.pop().map(Process::stop).transpose()?;
+    let log = system.0.pop().context("walkd")?.stop()?.log;
     Ok(Measurement {
         status,
         walking,

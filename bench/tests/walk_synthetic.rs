@@ -3,8 +3,8 @@
 
 mod walk_support;
 
-use daemon::bench::{Outcome, WalkOptions, walk};
 use daemon::controller::SolverKind;
+use walk_bench::{Outcome, WalkOptions, walk};
 
 fn synthetic(robot_name: &str, solver: SolverKind) {
     let robot = walk_support::robot(robot_name);

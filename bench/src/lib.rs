@@ -1,0 +1,23 @@
+//! The controller in closed loop with a simulator, in one process, and the tools built on it.
+//!
+//! - [`closed_loop`]: the one tick loop (measure → `Controller::tick` → simulator step), for the
+//!   kinematic simulator and MuJoCo alike.
+//! - [`walk`]: a walk to its end against the kinematic simulator; [`command`] is `walk-bench`.
+//! - [`sequence`]: where a bench walk comes from (a stance source or a file).
+//! - `physics` (feature `mujoco`): a walk under MuJoCo with fall detection, drift and the paper's
+//!   Fig. 6 trace.
+//!
+//! Binaries: `walk-bench` (a walk as fast as the machine runs) and `latency-report` (latency and
+//! deadline misses of the real multi-process system). This crate, not `daemon`, links the
+//! simulators: walkd itself links none.
+
+pub mod closed_loop;
+pub mod command;
+/// The controller walking under MuJoCo physics, in one process (feature `mujoco`).
+#[cfg(feature = "mujoco")]
+pub mod physics;
+pub mod sequence;
+pub mod walk;
+
+pub use closed_loop::{ClosedLoop, TickError};
+pub use walk::{Outcome, TickObservation, WalkError, WalkOptions, WalkReport, walk};

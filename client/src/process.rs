@@ -1,0 +1,266 @@
+//! Child processes: `walkd` and `walk-sim` started by `walkctl demo` and `walkctl evaluate`,
+//! the processes of the latency report, and those of the end-to-end tests. One implementation:
+//! each child's stderr goes to a temporary log (for error messages and for reading what it
+//! reported), it is stopped with SIGTERM and a grace period, and it is killed if dropped while
+//! it runs.
+
+use std::cell::RefCell;
+use std::ffi::{OsStr, OsString};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, bail};
+use shm_types::ClockMode;
+use shm_types::process::Physics;
+
+/// How long a child may take to exit after SIGTERM before it is killed.
+pub const STOP_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// A child process whose stderr goes to a temporary log file; killed if dropped while it runs.
+pub struct Process {
+    name: String,
+    child: RefCell<Child>,
+    log: PathBuf,
+}
+
+/// How a child ended when it was stopped.
+pub struct Stopped {
+    /// Why the stop was not clean (a failure exit status, or it ignored SIGTERM and was killed);
+    /// `None` when it exited successfully.
+    pub problem: Option<String>,
+    /// Everything it wrote to stderr.
+    pub log: String,
+}
+
+/// `name` in the directory of the running executable (where cargo puts all the binaries).
+pub fn sibling(name: &str) -> anyhow::Result<PathBuf> {
+    let path = executable_dir()?.join(name);
+    anyhow::ensure!(
+        path.is_file(),
+        "`{}` missing: build all binaries (cargo build --release --workspace --bins)",
+        path.display()
+    );
+    Ok(path)
+}
+
+impl Process {
+    /// Starts `program` with `args` and the extra environment `env`.
+    pub fn start(
+        program: &Path,
+        args: impl IntoIterator<Item = impl AsRef<OsStr>>,
+        env: &[(&str, &OsStr)],
+    ) -> anyhow::Result<Self> {
+        let name = program.file_name().map_or_else(
+            || program.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        static COUNT: AtomicU32 = AtomicU32::new(0);
+        let n = COUNT.fetch_add(1, Ordering::Relaxed);
+        let log = std::env::temp_dir().join(format!("walk-{}-{name}-{n}.log", std::process::id()));
+        let child = Command::new(program)
+            .args(args)
+            .envs(env.iter().copied())
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(std::fs::File::create(&log)?)
+            .spawn()
+            .with_context(|| format!("cannot start {}", program.display()))?;
+        Ok(Self {
+            name,
+            child: RefCell::new(child),
+            log,
+        })
+    }
+
+    /// Process id.
+    pub fn pid(&self) -> u32 {
+        self.child.borrow().id()
+    }
+
+    /// Sends `signal` (e.g. `libc::SIGTERM`, `libc::SIGKILL`).
+    pub fn signal(&self, signal: i32) {
+        // SAFETY: kill on our own child's pid has no memory-safety preconditions.
+        unsafe { libc::kill(self.pid() as libc::pid_t, signal) };
+    }
+
+    /// Whether the process still runs.
+    pub fn is_running(&self) -> bool {
+        matches!(self.child.borrow_mut().try_wait(), Ok(None))
+    }
+
+    /// Waits up to `timeout` for the exit; `None` if it still runs.
+    pub fn wait_exit(&self, timeout: Duration) -> Option<ExitStatus> {
+        let start = Instant::now();
+        loop {
+            if let Ok(Some(status)) = self.child.borrow_mut().try_wait() {
+                return Some(status);
+            }
+            if start.elapsed() > timeout {
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    /// Fails with the child's log if it has already exited.
+    pub fn check_running(&self) -> anyhow::Result<()> {
+        if let Ok(Some(status)) = self.child.borrow_mut().try_wait() {
+            bail!("{} exited ({status}):\n{}", self.name, self.log_text());
+        }
+        Ok(())
+    }
+
+    /// Waits until the child's stderr contains `text`.
+    pub fn wait_for_log(&self, text: &str, timeout: Duration) -> anyhow::Result<()> {
+        let start = Instant::now();
+        while !self.log_text().contains(text) {
+            if start.elapsed() > timeout {
+                bail!(
+                    "timed out after {timeout:?} waiting for `{text}` in the log of {}\n{}",
+                    self.name,
+                    self.log()
+                );
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        Ok(())
+    }
+
+    /// SIGTERM, then waits up to [`STOP_TIMEOUT`] (then SIGKILL).
+    pub fn stop(self) -> anyhow::Result<Stopped> {
+        self.signal(libc::SIGTERM);
+        let mut child = self.child.borrow_mut();
+        let start = Instant::now();
+        let problem = loop {
+            if let Some(status) = child.try_wait()? {
+                break (!status.success()).then(|| format!("{} exited with {status}", self.name));
+            }
+            if start.elapsed() > STOP_TIMEOUT {
+                child.kill()?;
+                child.wait()?;
+                break Some(format!("{} did not stop on SIGTERM; killed", self.name));
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        };
+        drop(child);
+        Ok(Stopped {
+            problem,
+            log: self.log_text(),
+        })
+    }
+
+    /// The child's stderr so far, headed by its name (for failure messages).
+    pub fn log(&self) -> String {
+        format!("--- {} stderr ---\n{}", self.name, self.log_text())
+    }
+
+    /// The child's stderr so far.
+    pub fn log_text(&self) -> String {
+        std::fs::read_to_string(&self.log).unwrap_or_default()
+    }
+}
+
+impl Drop for Process {
+    fn drop(&mut self) {
+        let child = self.child.get_mut();
+        if matches!(child.try_wait(), Ok(None)) {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+        let _ = std::fs::remove_file(&self.log);
+    }
+}
+
+/// Children started together, stopped together (newest first); stopped when dropped.
+#[derive(Default)]
+pub struct Processes(pub Vec<Process>);
+
+impl Processes {
+    /// SIGTERM to each child (newest first), waiting up to [`STOP_TIMEOUT`] each, then SIGKILL;
+    /// returns what went wrong.
+    pub fn shut_down(&mut self) -> anyhow::Result<Vec<String>> {
+        let mut problems = Vec::new();
+        while let Some(child) = self.0.pop() {
+            problems.extend(child.stop()?.problem);
+        }
+        Ok(problems)
+    }
+}
+
+impl Drop for Processes {
+    fn drop(&mut self) {
+        // On an error path: stop them gracefully; the error being returned matters more.
+        let _ = self.shut_down();
+    }
+}
+
+/// How to start a `walkd` and its `walk-sim` on one service prefix: the options both take.
+#[derive(Debug, Clone)]
+pub struct Launch {
+    /// Where the binaries are.
+    pub bin_dir: PathBuf,
+    /// The robot config.
+    pub config: PathBuf,
+    /// The service prefix of both.
+    pub prefix: String,
+    /// Realtime or lockstep.
+    pub clock: ClockMode,
+    /// Control (and sample) rate overriding the config's.
+    pub rate_hz: Option<f64>,
+    /// URDF overriding the config's.
+    pub urdf: Option<PathBuf>,
+}
+
+impl Launch {
+    /// The options both processes take.
+    pub fn common_args(&self) -> Vec<OsString> {
+        let mut args: Vec<OsString> = vec![
+            "--config".into(),
+            self.config.clone().into(),
+            "--service-prefix".into(),
+            self.prefix.clone().into(),
+            "--clock".into(),
+            self.clock.name().into(),
+        ];
+        if let Some(rate) = self.rate_hz {
+            args.extend(["--rate-hz".into(), rate.to_string().into()]);
+        }
+        if let Some(urdf) = &self.urdf {
+            args.extend(["--urdf".into(), urdf.clone().into()]);
+        }
+        args
+    }
+
+    /// Starts `walkd` with `extra` arguments and environment.
+    pub fn walkd(&self, extra: &[&str], env: &[(&str, &OsStr)]) -> anyhow::Result<Process> {
+        let mut args = self.common_args();
+        args.extend(extra.iter().map(OsString::from));
+        Process::start(&self.bin_dir.join("walkd"), args, env)
+    }
+
+    /// The arguments of `walk-sim` with `physics`.
+    pub fn walk_sim_args(&self, physics: Physics) -> Vec<OsString> {
+        let mut args = self.common_args();
+        args.extend(["--physics".into(), physics.name().into()]);
+        args
+    }
+
+    /// Starts `walk-sim` with `physics`.
+    pub fn walk_sim(&self, physics: Physics) -> anyhow::Result<Process> {
+        Process::start(
+            &self.bin_dir.join("walk-sim"),
+            self.walk_sim_args(physics),
+            &[],
+        )
+    }
+}
+
+/// The directory of the running executable (where cargo puts all the binaries).
+pub fn executable_dir() -> anyhow::Result<PathBuf> {
+    Ok(std::env::current_exe()?
+        .parent()
+        .context("the executable has no directory")?
+        .to_owned())
+}
