@@ -5,6 +5,9 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
+/// The section [`ControllerConfig`] is read from.
+const SECTION: &str = "controller";
+
 /// Controller tuning from the `[controller]` section; every key is optional (defaults below suit
 /// the vendored humanoids) and an unknown key is an error naming the file and key.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
@@ -162,7 +165,7 @@ impl Default for ControllerConfig {
     }
 }
 
-/// Why the `[controller]` section could not be read.
+/// Why a section of a robot config (`[controller]`, `[gait]`, ...) could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     /// The file could not be read.
@@ -181,19 +184,23 @@ pub enum ConfigError {
         /// The parse error.
         source: toml::de::Error,
     },
-    /// The `[controller]` section is missing, has an unknown key or a badly typed value.
-    #[error("{origin}: [controller]: {message}")]
+    /// The section is missing, has an unknown key or a badly typed value.
+    #[error("{origin}: [{section}]: {message}")]
     Section {
         /// File (or "<table>") the section came from.
         origin: String,
+        /// The section's name (`controller`, `gait.dynamic`, ...).
+        section: &'static str,
         /// What is wrong, naming the key.
         message: String,
     },
     /// A value is out of its meaningful range.
-    #[error("{origin}: [controller] {key} = {value}: {requirement}")]
+    #[error("{origin}: [{section}] {key} = {value}: {requirement}")]
     Value {
         /// File (or "<table>") the section came from.
         origin: String,
+        /// The section's name.
+        section: &'static str,
         /// The offending key.
         key: &'static str,
         /// Its value.
@@ -206,15 +213,7 @@ pub enum ConfigError {
 impl ControllerConfig {
     /// Reads the `[controller]` section of a robot config file.
     pub fn from_config_file(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-        let table: toml::Table = text.parse().map_err(|source| ConfigError::Toml {
-            path: path.to_owned(),
-            source,
-        })?;
-        Self::from_section(&table, &path.display().to_string())
+        Self::from_section(&read_table(path)?, &path.display().to_string())
     }
 
     /// Reads the `[controller]` section of an already parsed robot config.
@@ -223,18 +222,18 @@ impl ControllerConfig {
     }
 
     fn from_section(table: &toml::Table, origin: &str) -> Result<Self, ConfigError> {
-        let section = table
-            .get("controller")
-            .ok_or_else(|| ConfigError::Section {
-                origin: origin.to_owned(),
-                message: "section missing".to_owned(),
-            })?;
+        let section = table.get(SECTION).ok_or_else(|| ConfigError::Section {
+            origin: origin.to_owned(),
+            section: SECTION,
+            message: "section missing".to_owned(),
+        })?;
         let config: Self =
             section
                 .clone()
                 .try_into()
                 .map_err(|e: toml::de::Error| ConfigError::Section {
                     origin: origin.to_owned(),
+                    section: SECTION,
                     message: e.message().to_owned(),
                 })?;
         config.validate(origin)?;
@@ -304,6 +303,7 @@ impl ControllerConfig {
         ];
         let fail = |key, value, requirement| ConfigError::Value {
             origin: origin.to_owned(),
+            section: SECTION,
             key,
             value,
             requirement,
@@ -328,6 +328,18 @@ impl ControllerConfig {
         }
         Ok(())
     }
+}
+
+/// Reads and parses a robot config file.
+pub(crate) fn read_table(path: &Path) -> Result<toml::Table, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    text.parse().map_err(|source| ConfigError::Toml {
+        path: path.to_owned(),
+        source,
+    })
 }
 
 #[cfg(test)]

@@ -22,9 +22,11 @@
 mod assembly;
 mod config;
 mod estimator;
+mod gait;
 mod machine;
 mod plan;
 mod sequence;
+mod sequencer;
 mod status;
 mod trajectory;
 
@@ -36,12 +38,16 @@ use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{DVector, Isometry3, UnitQuaternion};
 
 pub use config::{ConfigError, ControllerConfig};
+pub use gait::{DynamicGaitConfig, GaitConfig, StabilizerConfig};
 pub use sequence::{PreparedSequence, Refusal};
-pub use status::{ControllerState, ControllerStatus, FaultCode, Phase};
+pub use stance::Gait;
+pub use status::{BalanceStatus, ControllerState, ControllerStatus, FaultCode, Phase};
 
 use assembly::QpAssembler;
 use estimator::BaseEstimator;
-use machine::{Feedback, Progress, StateMachine};
+use gait::{DynamicPlan, Sensors};
+use machine::{Feedback, Progress};
+use sequencer::Sequencer;
 
 use crate::qp::{ClarabelSolver, DenseActiveSetSolver, QpError, QpProblem, QpSolver};
 
@@ -127,7 +133,7 @@ pub struct Controller {
     kinematics: Kinematics,
     configuration: Configuration,
     estimator: BaseEstimator,
-    machine: StateMachine,
+    machine: Sequencer,
     assembler: QpAssembler,
     solution: Vec<f64>,
     poses: [Isometry3<f64>; 4],
@@ -159,7 +165,7 @@ impl Controller {
             kinematics: Kinematics::new(model),
             configuration: robot.standing.clone(),
             estimator: BaseEstimator::new(robot.standing.base),
-            machine: StateMachine::new(&config, robot.sole, weight),
+            machine: Sequencer::new(&config, robot.sole, weight),
             assembler: QpAssembler::new(&robot),
             solution: vec![0.0; nv],
             poses: [Isometry3::identity(); 4],
@@ -181,15 +187,36 @@ impl Controller {
         PreparedSequence::new(robot, config, seq)
     }
 
+    /// Non-RT: [`prepare`](Self::prepare) for `gait`; a dynamic walk is also planned here (its
+    /// footsteps and walking pattern), and refused when the config has no `[gait.dynamic]` or the
+    /// sequence does not end on both feet.
+    pub fn prepare_gait(
+        robot: &Robot,
+        config: &ControllerConfig,
+        gaits: &GaitConfig,
+        seq: &stance::PostProcessedSequence,
+        gait: Gait,
+    ) -> Result<PreparedSequence, Refusal> {
+        let mut prepared = PreparedSequence::new(robot, config, seq)?;
+        if gait == Gait::Dynamic {
+            let dynamic = gaits.dynamic().map_err(Refusal)?;
+            let plan = DynamicPlan::new(robot, &prepared.stances, dynamic)?;
+            prepared.dynamic = Some(Box::new(plan));
+        }
+        Ok(prepared)
+    }
+
     /// RT: begins executing `seq` from Idle, Holding or Done. Returns the previously held
     /// sequence (drop it off the RT thread); gives `seq` back while executing or in Fault (call
-    /// [`reset`](Self::reset) first).
+    /// [`reset`](Self::reset) first), and a dynamic one unless both feet stand (before the first
+    /// tick that is not known yet: the walk then faults if they do not).
     pub fn start(
         &mut self,
         seq: Box<PreparedSequence>,
     ) -> Result<Option<Box<PreparedSequence>>, Box<PreparedSequence>> {
         match self.status.state {
             ControllerState::Executing | ControllerState::Fault => Err(seq),
+            _ if self.world_ready && !self.machine.on_both_feet_for(&seq) => Err(seq),
             _ => {
                 let previous = self.machine.load(seq);
                 self.status.state = ControllerState::Executing;
@@ -232,7 +259,19 @@ impl Controller {
             poses: &self.poses,
             normal_forces: measurement.wrenches.map(|w| w[2]),
         };
-        match self.machine.update(&feedback, dt) {
+        let (robot, kinematics) = (&self.robot, &self.kinematics);
+        let sensors = || Sensors {
+            wrenches: measurement.wrenches,
+            ft_origins: robot.ft_sensors.map(|frame| {
+                kinematics
+                    .frame_pose(&robot.model, frame)
+                    .translation
+                    .vector
+            }),
+            base_rotation: self.configuration.base.rotation,
+            imu: measurement.imu_orientation,
+        };
+        match self.machine.update(&feedback, sensors, dt) {
             Progress::Running => {}
             Progress::Done => {
                 // Keep holding the last command: it carries the servo offsets of the load.
@@ -397,6 +436,7 @@ impl Controller {
         self.status.stance_count = count as u32;
         self.status.phase = self.machine.phase();
         self.status.contacts = self.machine.targets().contacts;
+        self.status.balance = *self.machine.balance();
     }
 
     fn enter_fault(&mut self, code: FaultCode) {
