@@ -190,6 +190,7 @@ mod walks {
             let report = walk_sequence(
                 robot_model.clone(),
                 controller,
+                &daemon::controller::GaitConfig::default(),
                 &sequence,
                 &PhysicsWalkOptions::default(),
             )
