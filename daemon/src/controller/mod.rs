@@ -293,7 +293,7 @@ impl Controller {
             .expect("executing implies a sequence");
         self.assembler.assemble(
             &self.robot,
-            &self.config,
+            &self.machine.qp_config(&self.config),
             &self.kinematics,
             &self.configuration,
             &self.last_command,

@@ -123,6 +123,16 @@ impl Sequencer {
         }
     }
 
+    /// The QP tuning of the running gait: `config`, with the dynamic gait's overrides while a
+    /// dynamic walk runs.
+    pub fn qp_config(&self, config: &ControllerConfig) -> ControllerConfig {
+        if self.dynamic.started() {
+            self.dynamic.qp_config(config)
+        } else {
+            *config
+        }
+    }
+
     /// The dynamic walk's balance readings (kept after it ended, zero before the first).
     pub fn balance(&self) -> &BalanceStatus {
         self.dynamic.balance()

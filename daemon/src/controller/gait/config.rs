@@ -54,6 +54,10 @@ pub struct DynamicGaitConfig {
     pub late_touchdown_max_s: f64,
     /// Descent speed of a foot that has not touched down at the planned instant (m/s).
     pub late_descent_speed: f64,
+    /// Replaces `[controller] hand_weight` in the dynamic gait: a hand held at its contact pose
+    /// while the body walks on at speed drags the torso round and the stance foot slips about its
+    /// vertical axis; absent: the `[controller]` value.
+    pub hand_weight: Option<f64>,
     /// The stabilizer closing the loop on force-torque and IMU.
     #[serde(skip)]
     pub stabilizer: StabilizerConfig,
@@ -72,6 +76,7 @@ impl Default for DynamicGaitConfig {
             early_touchdown_s: 0.1,
             late_touchdown_max_s: 0.2,
             late_descent_speed: 0.05,
+            hand_weight: None,
             stabilizer: StabilizerConfig::default(),
         }
     }
@@ -255,6 +260,7 @@ impl DynamicGaitConfig {
             ),
             (DYNAMIC, "hand_transition_s", self.hand_transition_s),
             (DYNAMIC, "com_height_m", self.com_height_m.unwrap_or(1.0)),
+            (DYNAMIC, "hand_weight", self.hand_weight.unwrap_or(1.0)),
             (DYNAMIC, "late_descent_speed", self.late_descent_speed),
             (STABILIZER, "dcm_gain", s.dcm_gain),
             (STABILIZER, "velocity_filter_s", s.velocity_filter_s),

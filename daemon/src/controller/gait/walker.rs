@@ -174,6 +174,15 @@ impl DynamicWalker {
         Some(&sequence.stances[self.stance_index()].posture)
     }
 
+    /// `config` with the dynamic gait's QP overrides.
+    pub fn qp_config(&self, config: &ControllerConfig) -> ControllerConfig {
+        let dynamic = &self.plan().config;
+        ControllerConfig {
+            hand_weight: dynamic.hand_weight.unwrap_or(config.hand_weight),
+            ..*config
+        }
+    }
+
     /// The current phase.
     pub fn phase(&self) -> Phase {
         if !self.started {
