@@ -72,7 +72,7 @@ impl Default for DynamicGaitConfig {
             final_double_support_s: 1.0,
             hand_transition_s: 0.5,
             com_height_m: None,
-            landing_depth_m: 0.003,
+            landing_depth_m: 0.001,
             early_touchdown_s: 0.1,
             late_touchdown_max_s: 0.2,
             late_descent_speed: 0.05,

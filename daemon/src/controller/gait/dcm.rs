@@ -45,6 +45,10 @@ pub(crate) struct ZmpSegment {
 }
 
 impl ZmpSegment {
+    fn end_s(&self) -> f64 {
+        self.start_s + self.duration_s
+    }
+
     fn zmp_velocity(&self) -> Vector2<f64> {
         (self.zmp_end - self.zmp_start) / self.duration_s
     }
@@ -195,14 +199,10 @@ impl DcmPattern {
             dcm_velocity: Vector2::zeros(),
         };
         *cursor = (*cursor).min(self.segments.len());
-        while *cursor > 0 && self.segments[*cursor - 1].start_s > t {
+        while *cursor > 0 && t < self.segments[*cursor - 1].end_s() {
             *cursor -= 1;
         }
-        while *cursor < self.segments.len() {
-            let segment = &self.segments[*cursor];
-            if t < segment.start_s + segment.duration_s {
-                break;
-            }
+        while *cursor < self.segments.len() && t >= self.segments[*cursor].end_s() {
             *cursor += 1;
         }
         let Some(segment) = self.segments.get(*cursor) else {
