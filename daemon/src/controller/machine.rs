@@ -399,7 +399,13 @@ impl StateMachine {
             }
             (phase, None) => unreachable!("phase {phase:?} needs an end-effector"),
             (Phase::None, _) => unreachable!("plans hold no empty phase"),
-            (Phase::DoubleSupport | Phase::SingleSupport | Phase::LateTouchdown, _) => {
+            (
+                Phase::DoubleSupport
+                | Phase::SingleSupport
+                | Phase::LateTouchdown
+                | Phase::LateLiftOff,
+                _,
+            ) => {
                 unreachable!("static plans hold no dynamic-gait phase")
             }
         };

@@ -57,6 +57,9 @@ pub enum Phase {
     /// Dynamic gait: the swing ended without a touchdown; the foot keeps descending and the plan
     /// waits, up to `late_touchdown_max_s`.
     LateTouchdown,
+    /// Dynamic gait: the double support ended with the foot to lift still loaded; the plan waits,
+    /// up to `late_lift_off_max_s`.
+    LateLiftOff,
 }
 
 impl Phase {
@@ -74,6 +77,7 @@ impl Phase {
             Self::DoubleSupport => "double_support",
             Self::SingleSupport => "single_support",
             Self::LateTouchdown => "late_touchdown",
+            Self::LateLiftOff => "late_lift_off",
         }
     }
 }

@@ -54,6 +54,9 @@ pub struct DynamicGaitConfig {
     pub late_touchdown_max_s: f64,
     /// Descent speed of a foot that has not touched down at the planned instant (m/s).
     pub late_descent_speed: f64,
+    /// A foot still loaded at its planned lift-off keeps its contact, and the plan waits, up to
+    /// this long; then it lifts (s).
+    pub late_lift_off_max_s: f64,
     /// Replaces `[controller] hand_weight` in the dynamic gait: a hand held at its contact pose
     /// while the body walks on at speed drags the torso round and the stance foot slips about its
     /// vertical axis; absent: the `[controller]` value.
@@ -76,6 +79,7 @@ impl Default for DynamicGaitConfig {
             early_touchdown_s: 0.1,
             late_touchdown_max_s: 0.2,
             late_descent_speed: 0.05,
+            late_lift_off_max_s: 0.2,
             hand_weight: None,
             stabilizer: StabilizerConfig::default(),
         }
@@ -275,6 +279,7 @@ impl DynamicGaitConfig {
             (DYNAMIC, "landing_depth_m", self.landing_depth_m),
             (DYNAMIC, "early_touchdown_s", self.early_touchdown_s),
             (DYNAMIC, "late_touchdown_max_s", self.late_touchdown_max_s),
+            (DYNAMIC, "late_lift_off_max_s", self.late_lift_off_max_s),
             (STABILIZER, "zmp_margin_m", s.zmp_margin_m),
             (STABILIZER, "zmp_offset_max_m", s.zmp_offset_max_m),
             (STABILIZER, "foot_damping_gain", s.foot_damping_gain),

@@ -1,9 +1,13 @@
 //! The dynamic gait's state machine: runs a [`DynamicPlan`] on its plan clock and produces the
 //! QP's set-points and contact set every tick.
 //!
-//! Phases advance on time. A double support ends with the lift-off of its foot (the foot leaves
-//! the contact set at the planned instant: the ZMP reference left it at the start of the phase).
-//! A single support ends with the touchdown, confirmed by force-torque (debounced):
+//! Phases advance on time (the ZMP reference leaves a foot before it lifts off and reaches it
+//! before it must carry the robot).
+//! A double support ends with the lift-off of its foot, once force-torque shows the weight off
+//! it (below `release_force_fraction` of the weight): while it still carries load the plan clock
+//! waits at the lift-off instant, up to `late_lift_off_max_s`, then the foot lifts anyway (a
+//! landing foot that bounced, a robot leaning back on the old stance foot). A single support
+//! ends with the touchdown, confirmed by force-torque (debounced):
 //! - early, within `early_touchdown_s` of the planned instant: the foot is anchored where it
 //!   landed and the plan runs on (the ZMP stays on the stance foot until the double support);
 //! - late: at the planned instant the plan clock stops, the foot keeps descending at
@@ -63,6 +67,7 @@ pub(crate) struct DynamicWalker {
     config: ControllerConfig,
     sole: SoleRectangle,
     touchdown_force: f64,
+    release_force: f64,
     sequence: Option<Box<PreparedSequence>>,
     running: bool,
     started: bool,
@@ -101,6 +106,7 @@ impl DynamicWalker {
             config: *config,
             sole,
             touchdown_force: config.touchdown_force_fraction * weight_n,
+            release_force: config.release_force_fraction * weight_n,
             sequence: None,
             running: false,
             started: false,
@@ -190,6 +196,7 @@ impl DynamicWalker {
         }
         match self.current_phase().map(|p| p.support) {
             None => Phase::Settle,
+            Some(Support::Double { .. }) if self.late_s.is_some() => Phase::LateLiftOff,
             Some(Support::Double { .. }) => Phase::DoubleSupport,
             Some(Support::Single(_)) if self.late_s.is_some() => Phase::LateTouchdown,
             Some(Support::Single(_)) => Phase::SingleSupport,
@@ -314,6 +321,14 @@ impl DynamicWalker {
                         return Progress::Running;
                     }
                     if let Some(foot) = lift_off {
+                        let loaded = feedback.normal_forces[foot as usize] > self.release_force;
+                        if loaded {
+                            self.clock = phase.end_s();
+                            let late = self.late_s.get_or_insert(0.0);
+                            if *late <= self.plan().config.late_lift_off_max_s {
+                                return Progress::Running;
+                            }
+                        }
                         self.lift_off(foot, feedback);
                     }
                 }
