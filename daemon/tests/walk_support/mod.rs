@@ -6,8 +6,10 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use daemon::bench::{Outcome, TickObservation, WalkOptions, WalkReport, walk};
-use daemon::controller::{Command, Controller, ControllerConfig, Measurement, Phase, SolverKind};
-use kinematic_sim::KinematicSim;
+use daemon::controller::{
+    Command, Controller, ControllerConfig, Gait, GaitConfig, Measurement, Phase, SolverKind,
+};
+use kinematic_sim::{KinematicSim, SimOptions};
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Translation3};
@@ -23,6 +25,17 @@ pub fn config_path(name: &str) -> PathBuf {
 /// The vendored robot `name`.
 pub fn robot(name: &str) -> Arc<Robot> {
     Arc::new(Robot::load(&config_path(name), None).expect("vendored robot loads"))
+}
+
+/// The `[gait]` section of `name`'s config, for the kinematic simulator: the parts of the
+/// stabilizer that need forces and inertia (foot damping, tilt damping) switched off, as an ideal
+/// kinematic robot has neither: its synthetic centre of pressure follows the commanded motion.
+pub fn kinematic_gait_config(name: &str) -> GaitConfig {
+    let mut gaits = GaitConfig::from_config_file(&config_path(name)).expect("gait config parses");
+    let stabilizer = &mut gaits.dynamic.as_mut().expect("a dynamic gait").stabilizer;
+    stabilizer.foot_damping = false;
+    stabilizer.tilt_damping = false;
+    gaits
 }
 
 /// The `[controller]` section of `name`'s config.
@@ -202,10 +215,32 @@ impl Harness {
         }
     }
 
+    /// A standing robot `name` for dynamic walks: the simulator judges by the ZMP.
+    pub fn dynamic(name: &str, rate_hz: f64) -> Self {
+        let mut harness = Self::new(name, rate_hz);
+        let options = SimOptions {
+            judge_by_zmp: true,
+            ..SimOptions::default()
+        };
+        let robot = harness.robot.clone();
+        harness.sim =
+            KinematicSim::with_options(robot.clone(), robot.standing.clone(), options).unwrap();
+        harness
+    }
+
     /// Prepares and starts `sequence`.
     pub fn start(&mut self, sequence: &PostProcessedSequence) {
         let config = controller_config(&self.robot.name);
         let prepared = Controller::prepare(&self.robot, &config, sequence).unwrap();
+        assert!(self.controller.start(Box::new(prepared)).is_ok());
+    }
+
+    /// Prepares `sequence` for the dynamic gait with `gaits` and starts it.
+    pub fn start_dynamic(&mut self, sequence: &PostProcessedSequence, gaits: &GaitConfig) {
+        let config = controller_config(&self.robot.name);
+        let prepared =
+            Controller::prepare_gait(&self.robot, &config, gaits, sequence, Gait::Dynamic)
+                .expect("sequence accepted");
         assert!(self.controller.start(Box::new(prepared)).is_ok());
     }
 

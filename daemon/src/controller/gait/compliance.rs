@@ -9,8 +9,10 @@
 //!
 //! - **Foot damping**: a foot turns about the horizontal axes so that its measured CoP moves to
 //!   the desired one: `ω_x = −A f_z (cop_d − cop_m)_y`, `ω_y = A f_z (cop_d − cop_m)_x` (A in
-//!   rad/s per N·m; the angular velocity pressing the side that should carry more). The sole is
-//!   on the ground, so the servos turn that into ankle torque.
+//!   rad/s per N·m; the angular velocity pressing the side that should carry more), less `θ/τ`
+//!   of the rotation `θ` it has accumulated since the foot landed (a leak: a CoP error that the
+//!   ankle cannot remove does not wind it up to its limit). The sole is on the ground, so the
+//!   servos turn that into ankle torque.
 //! - **Force difference** (double support): the feet move vertically against each other,
 //!   `v = K (Δf_d − Δf_m)` with `Δf = f_left − f_right` (K in m/s per N): the left foot by
 //!   `−v/2`, the right by `+v/2`, so the foot that should carry more presses down.
@@ -19,7 +21,8 @@
 //!   which swings the ZMP by centimetres. For a body of inertia `I` about the sole on a contact of
 //!   rotational stiffness `k`, `I θ̈ = −k (θ − φ) + m g h θ` (θ: body tilt, φ: ankle angle), so an
 //!   ankle that turns against the body's tilt rate, `φ = −K_d θ̇` (IMU), adds the damping
-//!   `k K_d θ̇`. The feet in contact turn by `K_d θ̇` relative to the body held by the other tasks.
+//!   `k K_d θ̇`. The feet in contact turn by `K_d θ̇` relative to the body held by the other tasks,
+//!   at most by a bound (a rigid, kinematic robot would turn its feet with nothing to damp).
 
 use kinematics::robot::SoleRectangle;
 use nalgebra::{Isometry3, Point3, Vector2};
@@ -73,17 +76,18 @@ pub(crate) fn distribute(
 }
 
 /// The foot damping's angular velocity (world x, y; rad/s) for a foot with normal force `force`
-/// (N) whose CoP is `measured` and should be `desired`.
+/// (N) whose CoP is `measured` and should be `desired`, having turned by `turned` (rad) so far.
 pub(crate) fn foot_damping(
     desired: Vector2<f64>,
     measured: Vector2<f64>,
     force: f64,
+    turned: Vector2<f64>,
     config: &StabilizerConfig,
-) -> [f64; 2] {
+) -> Vector2<f64> {
     let error = desired - measured;
     let rate = config.foot_damping_gain * force.max(0.0);
-    let omega = Vector2::new(-rate * error.y, rate * error.x);
-    bounded(omega, config.foot_damping_max_speed).into()
+    let omega = Vector2::new(-rate * error.y, rate * error.x) - turned / config.foot_damping_leak_s;
+    bounded(omega, config.foot_damping_max_speed)
 }
 
 /// The force-difference velocity `v` (m/s; the left foot moves by `−v/2`, the right by `+v/2`)
@@ -111,9 +115,15 @@ impl TiltDamping {
     }
 
     /// The angular velocity (world x, y) of the feet in contact that turns them to
-    /// `gain · tilt_rate` within `dt` (`gain` = `K_d`, s).
-    pub fn velocity(&mut self, tilt_rate: Vector2<f64>, gain: f64, dt: f64) -> Vector2<f64> {
-        let target = tilt_rate * gain;
+    /// `gain · tilt_rate` (`gain` = `K_d`, s), at most `max` (rad), within `dt`.
+    pub fn velocity(
+        &mut self,
+        tilt_rate: Vector2<f64>,
+        gain: f64,
+        max: f64,
+        dt: f64,
+    ) -> Vector2<f64> {
+        let target = bounded(tilt_rate * gain, max);
         let velocity = (target - self.applied) / dt;
         self.applied = target;
         velocity
@@ -189,11 +199,15 @@ mod tests {
     fn damping_presses_the_side_that_should_carry_more() {
         let config = StabilizerConfig::default();
         // Desired CoP ahead (+x) and to the left (+y) of the measured one.
-        let [wx, wy] = foot_damping(Vector2::new(0.01, 0.01), Vector2::zeros(), 300.0, &config);
-        assert!(wy > 0.0, "turning about +y presses the toes down");
-        assert!(wx < 0.0, "turning about −x presses the left edge down");
-        let [wx, wy] = foot_damping(Vector2::new(1.0, 0.0), Vector2::zeros(), 1e6, &config);
-        assert!((wx.hypot(wy) - config.foot_damping_max_speed).abs() < 1e-12);
+        let none = Vector2::zeros();
+        let turn = foot_damping(Vector2::new(0.01, 0.01), none, 300.0, none, &config);
+        assert!(turn.y > 0.0, "turning about +y presses the toes down");
+        assert!(turn.x < 0.0, "turning about −x presses the left edge down");
+        let fast = foot_damping(Vector2::new(1.0, 0.0), none, 1e6, none, &config);
+        assert!((fast.norm() - config.foot_damping_max_speed).abs() < 1e-12);
+        // Without a CoP error the accumulated rotation leaks away.
+        let back = foot_damping(none, none, 300.0, Vector2::new(0.01, 0.0), &config);
+        assert!((back.x + 0.01 / config.foot_damping_leak_s).abs() < 1e-12 && back.y == 0.0);
     }
 
     #[test]
@@ -202,10 +216,13 @@ mod tests {
         let dt = 0.002;
         let mut turned = Vector2::zeros();
         for rate in [0.1, 0.3, -0.2] {
-            turned += damping.velocity(Vector2::new(rate, 0.0), 0.03, dt) * dt;
+            turned += damping.velocity(Vector2::new(rate, 0.0), 0.03, 0.02, dt) * dt;
             // The feet have turned by K_d θ̇ in all: the ankles by its opposite.
             assert!((turned.x - 0.03 * rate).abs() < 1e-12);
         }
+        // Never further than the bound.
+        turned += damping.velocity(Vector2::new(10.0, 0.0), 0.03, 0.02, dt) * dt;
+        assert!((turned.x - 0.02).abs() < 1e-12);
     }
 
     #[test]

@@ -118,6 +118,8 @@ pub struct StabilizerConfig {
     pub foot_damping_gain: f64,
     /// Bound on the foot damping's angular velocity (rad/s).
     pub foot_damping_max_speed: f64,
+    /// Time constant of the leak of the foot damping's accumulated rotation (s).
+    pub foot_damping_leak_s: f64,
     /// Force-difference control in double support: the feet move vertically against each other
     /// until their normal forces split as the desired ZMP asks.
     pub force_difference: bool,
@@ -132,6 +134,8 @@ pub struct StabilizerConfig {
     pub tilt_damping_s: f64,
     /// Time constant of the low-pass filter on the tilt rate (s).
     pub tilt_rate_filter_s: f64,
+    /// Bound on the tilt damping's ankle rotation (rad).
+    pub tilt_damping_max_rad: f64,
 }
 
 impl Default for StabilizerConfig {
@@ -148,12 +152,14 @@ impl Default for StabilizerConfig {
             foot_damping: true,
             foot_damping_gain: 1e-4,
             foot_damping_max_speed: 0.2,
+            foot_damping_leak_s: 1.0,
             force_difference: true,
             force_difference_gain: 1e-5,
             force_difference_max_speed: 0.02,
             tilt_damping: true,
             tilt_damping_s: 0.03,
             tilt_rate_filter_s: 0.01,
+            tilt_damping_max_rad: 0.01,
         }
     }
 }
@@ -274,6 +280,7 @@ impl DynamicGaitConfig {
                 s.zmp_offset_time_constant_s,
             ),
             (STABILIZER, "tilt_rate_filter_s", s.tilt_rate_filter_s),
+            (STABILIZER, "foot_damping_leak_s", s.foot_damping_leak_s),
         ];
         let non_negative = [
             (DYNAMIC, "landing_depth_m", self.landing_depth_m),
@@ -295,6 +302,7 @@ impl DynamicGaitConfig {
                 s.force_difference_max_speed,
             ),
             (STABILIZER, "tilt_damping_s", s.tilt_damping_s),
+            (STABILIZER, "tilt_damping_max_rad", s.tilt_damping_max_rad),
         ];
         let fail = |section, key, value, requirement| ConfigError::Value {
             origin: origin.to_owned(),

@@ -89,6 +89,8 @@ pub(crate) struct DynamicWalker {
     estimator: DcmEstimator,
     tilt_rate: TiltRate,
     tilt_damping: TiltDamping,
+    /// The foot damping's rotation of each foot since it landed (world x, y; rad).
+    foot_turn: [Vector2<f64>; 2],
     support: SupportPolygon,
     targets: Targets,
     balance: BalanceStatus,
@@ -125,6 +127,7 @@ impl DynamicWalker {
             estimator: DcmEstimator::default(),
             tilt_rate: TiltRate::default(),
             tilt_damping: TiltDamping::default(),
+            foot_turn: [Vector2::zeros(); 2],
             support: SupportPolygon::empty(),
             targets,
             balance: BalanceStatus::default(),
@@ -278,6 +281,7 @@ impl DynamicWalker {
         self.estimator.reset();
         self.tilt_rate.reset();
         self.tilt_damping.reset();
+        self.foot_turn = [Vector2::zeros(); 2];
         self.started = true;
         self.clock = 0.0;
         self.phase = 0;
@@ -523,15 +527,16 @@ impl DynamicWalker {
             .map(|f| forces[f])
             .sum();
         for f in 0..2 {
-            let Some(load) = loads[f] else { continue };
-            if !config.foot_damping {
+            let (Some(load), true) = (loads[f], config.foot_damping) else {
+                self.foot_turn[f] = Vector2::zeros();
                 continue;
-            }
+            };
             let wrench = [(&sensors.wrenches[FEET[f] as usize], &sensors.ft_origins[f])];
             if let Some(cop) = pressure_centre(wrench, ground, 0.5 * self.touchdown_force) {
-                let [wx, wy] = foot_damping(load.cop, cop, forces[f], &config);
-                self.targets.contact_velocity[f][3] = wx;
-                self.targets.contact_velocity[f][4] = wy;
+                let turn = foot_damping(load.cop, cop, forces[f], self.foot_turn[f], &config);
+                self.foot_turn[f] += turn * dt;
+                self.targets.contact_velocity[f][3] = turn.x;
+                self.targets.contact_velocity[f][4] = turn.y;
             }
         }
         if let (true, [Some(left), Some(right)]) = (config.force_difference, loads) {
@@ -542,7 +547,8 @@ impl DynamicWalker {
         }
         if let (true, Some(imu)) = (config.tilt_damping, &sensors.imu) {
             let rate = self.tilt_rate.update(imu, dt, config.tilt_rate_filter_s);
-            let turn = self.tilt_damping.velocity(rate, config.tilt_damping_s, dt);
+            let (gain, max) = (config.tilt_damping_s, config.tilt_damping_max_rad);
+            let turn = self.tilt_damping.velocity(rate, gain, max, dt);
             for (f, velocity) in self.targets.contact_velocity.iter_mut().enumerate() {
                 if feet[f].is_some() {
                     velocity[3] += turn.x;
