@@ -21,12 +21,10 @@ fn run(h: &mut Harness, limit: usize, mut each: impl FnMut(&Harness)) {
     }
 }
 
-/// JVRC-1 only: ARMAR-4's QP does not follow the pattern (its ±0.06 rad ankle roll leaves the
-/// lateral CoM motion to a pelvis roll, its CoM rises 2 cm in single support), so its kinematic
-/// ZMP leaves the support (docs/controller.md, "Dynamic gait").
 #[test]
 fn the_zmp_of_a_dynamic_walk_stays_inside_the_support() {
-    for robot in ["jvrc1"] {
+    let robot = "jvrc1";
+    {
         let mut h = Harness::dynamic(robot, 500.0);
         let sequence = synthetic_walk(&h.robot, 6, 0.12, false);
         h.start_dynamic(&sequence, &kinematic_gait_config(robot));
