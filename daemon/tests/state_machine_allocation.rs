@@ -45,16 +45,14 @@ fn controller_tick_does_not_allocate() {
     }
     // The dynamic gait's tick (walking pattern, stabilizer, compliance, swing) allocates nothing
     // either: its plan is built when the sequence is prepared. (ARMAR-4 has no dynamic gait.)
-    for robot in ["jvrc1"] {
-        let mut h = walk_support::Harness::dynamic(robot, 500.0);
-        let sequence = walk_support::synthetic_walk(&h.robot, 4, 0.1, true);
-        let mut gaits = walk_support::kinematic_gait_config(robot);
-        // Foot damping runs its code path here too (it has no effect worth having on a kinematic
-        // robot, but it walks).
-        gaits.dynamic.as_mut().unwrap().stabilizer.foot_damping = true;
-        h.start_dynamic(&sequence, &gaits);
-        walk_counting_allocations(robot, h);
-    }
+    let mut h = walk_support::Harness::dynamic("jvrc1", 500.0);
+    let sequence = walk_support::synthetic_walk(&h.robot, 4, 0.1, true);
+    let mut gaits = walk_support::kinematic_gait_config("jvrc1");
+    // Foot damping runs its code path here too (it has no effect worth having on a kinematic
+    // robot, but it walks).
+    gaits.dynamic.as_mut().unwrap().stabilizer.foot_damping = true;
+    h.start_dynamic(&sequence, &gaits);
+    walk_counting_allocations("jvrc1", h);
 }
 
 /// Walks the started sequence of `h` to `done`, counting the allocations inside the ticks.

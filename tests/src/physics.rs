@@ -100,13 +100,6 @@ pub struct Push {
     pub duration_s: f64,
 }
 
-impl Push {
-    /// Its impulse (N·s).
-    pub fn impulse(&self) -> f64 {
-        Vector3::from(self.force_n).norm() * self.duration_s
-    }
-}
-
 /// How a physics walk ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PhysicsOutcome {
@@ -205,8 +198,9 @@ pub struct BalanceSample {
     pub phase: Phase,
     /// The controller's ZMP and DCM readings.
     pub balance: BalanceStatus,
-    /// The controller's estimated CoM and the simulator's (m).
+    /// The controller's estimated CoM (m).
     pub com_estimated: [f64; 3],
+    /// The simulator's CoM (m).
     pub com_true: [f64; 3],
     /// Normal force on each foot (left, right; N).
     pub foot_forces: [f64; 2],
@@ -216,11 +210,13 @@ pub struct BalanceSample {
 /// ticks. The true DCM is the simulator's CoM plus its velocity over ω = √(g / z_CoM).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BalanceTracking {
-    /// Measured (ankle wrenches) minus reference ZMP: root mean square and largest.
+    /// Measured (ankle wrenches) minus reference ZMP, root mean square.
     pub zmp_rms_m: f64,
+    /// Measured minus reference ZMP, largest.
     pub zmp_max_m: f64,
-    /// True minus reference DCM: root mean square and largest.
+    /// True minus reference DCM, root mean square.
     pub dcm_rms_m: f64,
+    /// True minus reference DCM, largest.
     pub dcm_max_m: f64,
     /// Largest estimated CoM model error (the stabilizer's ZMP offset).
     pub com_offset_max_m: f64,

@@ -483,7 +483,7 @@ impl DynamicWalker {
         let zmp = pressure_centre(foot_wrenches(), ground, self.touchdown_force);
         let mut com = feedback.com;
         if let (true, Some(imu)) = (config.imu_tilt, sensors.imu) {
-            let pivot = zmp.unwrap_or_else(|| reference.zmp);
+            let pivot = zmp.unwrap_or(reference.zmp);
             let pivot = Vector3::new(pivot.x, pivot.y, ground);
             com = tilted_com(&com, &pivot, &imu, &sensors.base_rotation);
         }
