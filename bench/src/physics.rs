@@ -21,10 +21,13 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use client::evaluate::{Points, TraceSample, align_targets, stance_points};
 use daemon::controller::{
-    Controller, ControllerConfig, ControllerState, ControllerStatus, FaultCode, SolverKind,
+    BalanceStatus, Controller, ControllerConfig, ControllerState, ControllerStatus,
+    DynamicGaitConfig, FaultCode, Gait, GaitConfig, Phase, SolverKind,
 };
 use kinematics::ConfigFile;
+use kinematics::ground::GRAVITY;
 use kinematics::robot::{EndEffector, Robot};
+use nalgebra::{Vector2, Vector3};
 use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim};
 use stance::poses::FEET;
 use stance::{
@@ -49,6 +52,12 @@ pub struct PhysicsWalkOptions {
     pub trace_every: u64,
     /// The physics model (the walk-sim defaults).
     pub mujoco: MujocoOptions,
+    /// The gait the sequence is post-processed for and walked with.
+    pub gait: Gait,
+    /// Replaces the robot config's `[gait.dynamic]` (experiments); `None`: the config's.
+    pub dynamic: Option<DynamicGaitConfig>,
+    /// A push on the pelvis during the walk.
+    pub push: Option<Push>,
 }
 
 impl Default for PhysicsWalkOptions {
@@ -60,8 +69,40 @@ impl Default for PhysicsWalkOptions {
             settle_s: 1.0,
             trace_every: 10,
             mujoco: MujocoOptions::default(),
+            gait: Gait::Static,
+            dynamic: None,
+            push: None,
         }
     }
+}
+
+impl PhysicsWalkOptions {
+    /// The defaults for a dynamic walk. Its FT readings are the mean over each control period's
+    /// physics steps (`MujocoOptions::average_ft_over_step`): the stabilizer's measured ZMP is
+    /// built from them, and the last step's reading alone is biased by the servos' answer to
+    /// each new command.
+    pub fn dynamic() -> Self {
+        Self {
+            gait: Gait::Dynamic,
+            mujoco: MujocoOptions {
+                average_ft_over_step: true,
+                ..MujocoOptions::default()
+            },
+            ..Self::default()
+        }
+    }
+}
+
+/// An external force on the pelvis (MuJoCo `xfrc_applied`), centred on the middle of a single
+/// support of the dynamic gait.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Push {
+    /// Which single support (0: the first step).
+    pub step: usize,
+    /// Force (N, world frame).
+    pub force_n: [f64; 3],
+    /// How long it acts (s).
+    pub duration_s: f64,
 }
 
 /// How a physics walk ended.
@@ -142,6 +183,48 @@ pub struct PhysicsWalkReport {
     /// The Fig. 6 trace (every [`PhysicsWalkOptions::trace_every`] ticks), with the simulator's
     /// truth; draw it with `client::evaluate::write_fig6`.
     pub trace: Vec<TraceSample>,
+    /// Simulated time of the first step: a foot left the controller's contact set (s).
+    pub first_step_s: Option<f64>,
+    /// Wall time of each `Controller::tick` (µs): median, 99th percentile, largest.
+    pub tick_us: [f64; 3],
+    /// The dynamic gait's balance tracking over the walk (zero for the static gait).
+    pub balance: BalanceTracking,
+    /// The controller's balance readings next to the simulator's CoM, every
+    /// [`PhysicsWalkOptions::trace_every`] ticks.
+    pub balance_trace: Vec<BalanceSample>,
+}
+
+/// One sample of [`PhysicsWalkReport::balance_trace`].
+#[derive(Clone, Copy, Debug)]
+pub struct BalanceSample {
+    /// Simulated time (s).
+    pub t: f64,
+    /// The controller's phase.
+    pub phase: Phase,
+    /// The controller's ZMP and DCM readings.
+    pub balance: BalanceStatus,
+    /// The controller's estimated CoM (m).
+    pub com_estimated: [f64; 3],
+    /// The simulator's CoM (m).
+    pub com_true: [f64; 3],
+    /// Normal force on each foot (left, right; N).
+    pub foot_forces: [f64; 2],
+}
+
+/// How closely a dynamic walk's ZMP and DCM followed the walking pattern (m), over the executing
+/// ticks. The true DCM is the simulator's CoM plus its velocity over ω = √(g / z_CoM).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BalanceTracking {
+    /// Measured (ankle wrenches) minus reference ZMP, root mean square.
+    pub zmp_rms_m: f64,
+    /// Measured minus reference ZMP, largest.
+    pub zmp_max_m: f64,
+    /// True minus reference DCM, root mean square.
+    pub dcm_rms_m: f64,
+    /// True minus reference DCM, largest.
+    pub dcm_max_m: f64,
+    /// Largest estimated CoM model error (the stabilizer's ZMP offset).
+    pub com_offset_max_m: f64,
 }
 
 impl PhysicsWalkReport {
@@ -159,6 +242,13 @@ impl PhysicsWalkReport {
     pub fn real_time_factor(&self) -> f64 {
         self.total_sim_s / self.wall_s
     }
+
+    /// Walking speed: the distance walked over the time from the first step to the outcome
+    /// (m/s); `None` if the robot never stepped.
+    pub fn speed_m_s(&self) -> Option<f64> {
+        self.first_step_s
+            .map(|first| self.distance_m / (self.sim_s - first))
+    }
 }
 
 /// Generates a forward walk of `distance` metres for the robot of `config` (seeded), post-
@@ -175,21 +265,27 @@ pub fn walk_distance(
     let robot = Arc::new(
         Robot::from_config(&file, urdf).with_context(|| format!("loading {}", config.display()))?,
     );
-    let params = PostProcessParams::from_config(&file)?;
+    let params = PostProcessParams::from_config_for(&file, options.gait)?;
     let controller_config = ControllerConfig::from_config(&file)?;
+    let mut gaits = GaitConfig::from_config(&file)?;
+    if options.dynamic.is_some() {
+        gaits.dynamic = options.dynamic;
+    }
     let request = WalkRequest {
         distance,
         affordances,
         seed,
     };
     let sequence = synthetic_walk(&robot, &params, &request)?;
-    walk_sequence(robot, controller_config, &sequence, options)
+    walk_sequence(robot, controller_config, &gaits, &sequence, options)
 }
 
-/// Executes `sequence` on `robot`, starting from its standing posture, in closed loop with MuJoCo.
+/// Executes `sequence` on `robot` with `options.gait` (tuned by `gaits`), starting from its
+/// standing posture, in closed loop with MuJoCo.
 pub fn walk_sequence(
     robot: Arc<Robot>,
     config: ControllerConfig,
+    gaits: &GaitConfig,
     sequence: &PostProcessedSequence,
     options: &PhysicsWalkOptions,
 ) -> anyhow::Result<PhysicsWalkReport> {
@@ -198,8 +294,12 @@ pub fn walk_sequence(
         "rate {} Hz: must be a positive number",
         options.rate_hz
     );
-    let prepared = Controller::prepare(&robot, &config, sequence)
+    let prepared = Controller::prepare_gait(&robot, &config, gaits, sequence, options.gait)
         .map_err(|refusal| anyhow::anyhow!("the controller refused the sequence: {refusal}"))?;
+    let push = options.push.map(|push| {
+        let single_support = gaits.dynamic.map_or(0.0, |d| d.single_support_s);
+        PushSchedule::new(push, single_support)
+    });
     let mut targets = stance_points(&robot, sequence);
     let controller = Controller::new(robot.clone(), config, options.solver)?;
     let sim = MujocoSim::new(robot.clone(), &robot.urdf, &robot.standing, options.mujoco)
@@ -229,6 +329,11 @@ pub fn walk_sequence(
         min_margin: f64::INFINITY,
         controller_time: Duration::ZERO,
         physics_time: Duration::ZERO,
+        tick_ns: Vec::with_capacity(max_ticks.min(1 << 22) as usize),
+        balance_trace: Vec::new(),
+        first_step_s: None,
+        push,
+        balance: BalanceAccumulator::default(),
     };
     let wall = Instant::now();
     let mut ticks = 0u64;
@@ -240,6 +345,8 @@ pub fn walk_sequence(
             break outcome;
         }
         ticks += 1;
+        let dt = closed.dt();
+        loop_state.observe_walk(&mut closed.sim, closed.controller.status(), dt);
         let (sim, status) = (&closed.sim, closed.controller.status());
         loop_state.observe(sim, status);
         if options.trace_every > 0 && ticks % options.trace_every == 0 {
@@ -251,6 +358,15 @@ pub fn walk_sequence(
                 sim: Some(sim_points(sim)),
             };
             loop_state.trace.push(sample);
+            let m = sim.measurement();
+            loop_state.balance_trace.push(BalanceSample {
+                t: sim.time(),
+                phase: status.phase,
+                balance: status.balance,
+                com_estimated: status.com,
+                com_true: m.com.into(),
+                foot_forces: [m.wrenches[0][2], m.wrenches[1][2]],
+            });
         }
         if sim.has_fallen() {
             break PhysicsOutcome::Fell { at_s: sim.time() };
@@ -281,6 +397,7 @@ pub fn walk_sequence(
     }
     let wall_s = wall.elapsed().as_secs_f64();
     let sim = &closed.sim;
+    let tick_us = percentiles_us(&mut loop_state.tick_ns);
     let last = targets[targets.len() - 1];
     let final_position_error_m = sim_points(sim).distances(&last).1;
     Ok(PhysicsWalkReport {
@@ -303,7 +420,131 @@ pub fn walk_sequence(
         max_tilt_rad: loop_state.max_tilt,
         min_base_height_ratio: loop_state.min_height / initial_height,
         trace: loop_state.trace,
+        first_step_s: loop_state.first_step_s,
+        tick_us,
+        balance: loop_state.balance.tracking(),
+        balance_trace: loop_state.balance_trace,
     })
+}
+
+/// Median, 99th percentile and largest of tick durations in ns, as µs.
+fn percentiles_us(ticks: &mut [u64]) -> [f64; 3] {
+    if ticks.is_empty() {
+        return [0.0; 3];
+    }
+    ticks.sort_unstable();
+    let at = |q: f64| ticks[((ticks.len() - 1) as f64 * q).round() as usize] as f64 / 1e3;
+    [at(0.5), at(0.99), at(1.0)]
+}
+
+/// When a [`Push`] acts: from the middle of its single support less half its duration.
+#[derive(Clone, Copy, Debug)]
+struct PushSchedule {
+    push: Push,
+    /// Time into the single support at which it starts (s).
+    start_s: f64,
+    /// Single supports seen so far, and the simulated time the current one began.
+    steps: usize,
+    single_support_since: Option<f64>,
+    /// The simulated time the force was applied, once it was.
+    applied_at: Option<f64>,
+    done: bool,
+}
+
+impl PushSchedule {
+    fn new(push: Push, single_support_s: f64) -> Self {
+        Self {
+            push,
+            start_s: (single_support_s - push.duration_s).max(0.0) / 2.0,
+            steps: 0,
+            single_support_since: None,
+            applied_at: None,
+            done: false,
+        }
+    }
+
+    /// The force to apply after a tick that ended in `phase` at simulated time `t`.
+    fn force(&mut self, phase: Phase, t: f64) -> Vector3<f64> {
+        if self.done {
+            return Vector3::zeros();
+        }
+        let single = matches!(phase, Phase::SingleSupport | Phase::LateTouchdown);
+        match (single, self.single_support_since) {
+            (true, None) => self.single_support_since = Some(t),
+            (false, Some(_)) => {
+                self.single_support_since = None;
+                self.steps += 1;
+            }
+            _ => {}
+        }
+        if let Some(applied) = self.applied_at {
+            if t - applied >= self.push.duration_s - 1e-9 {
+                self.done = true;
+                return Vector3::zeros();
+            }
+            return Vector3::from(self.push.force_n);
+        }
+        match self.single_support_since {
+            Some(since) if self.steps == self.push.step && t - since >= self.start_s => {
+                self.applied_at = Some(t);
+                Vector3::from(self.push.force_n)
+            }
+            _ => Vector3::zeros(),
+        }
+    }
+}
+
+/// Sums for [`BalanceTracking`].
+#[derive(Clone, Copy, Debug, Default)]
+struct BalanceAccumulator {
+    zmp: (f64, f64, usize),
+    dcm: (f64, f64, usize),
+    com_offset_max: f64,
+    previous_com: Option<Vector3<f64>>,
+}
+
+impl BalanceAccumulator {
+    fn add(sum: &mut (f64, f64, usize), error: f64) {
+        sum.0 += error * error;
+        sum.1 = sum.1.max(error);
+        sum.2 += 1;
+    }
+
+    fn observe(&mut self, status: &ControllerStatus, true_com: Vector3<f64>, dt: f64) {
+        let previous = self.previous_com.replace(true_com);
+        let b = &status.balance;
+        if status.state != ControllerState::Executing {
+            return;
+        }
+        let reference = Vector2::from(b.zmp_reference);
+        let measured = Vector2::from(b.zmp_measured);
+        if measured.iter().all(|v| v.is_finite()) {
+            Self::add(&mut self.zmp, (measured - reference).norm());
+        }
+        if let Some(previous) = previous {
+            let omega = (GRAVITY / true_com.z).sqrt();
+            let dcm = true_com.xy() + (true_com - previous).xy() / dt / omega;
+            Self::add(&mut self.dcm, (dcm - Vector2::from(b.dcm_reference)).norm());
+        }
+        self.com_offset_max = self.com_offset_max.max(Vector2::from(b.com_offset).norm());
+    }
+
+    fn tracking(&self) -> BalanceTracking {
+        let rms = |sum: &(f64, f64, usize)| {
+            if sum.2 == 0 {
+                0.0
+            } else {
+                (sum.0 / sum.2 as f64).sqrt()
+            }
+        };
+        BalanceTracking {
+            zmp_rms_m: rms(&self.zmp),
+            zmp_max_m: self.zmp.1,
+            dcm_rms_m: rms(&self.dcm),
+            dcm_max_m: self.dcm.1,
+            com_offset_max_m: self.com_offset_max,
+        }
+    }
 }
 
 /// What the closed loop accumulates while it runs.
@@ -316,6 +557,11 @@ struct LoopState {
     min_margin: f64,
     controller_time: Duration,
     physics_time: Duration,
+    tick_ns: Vec<u64>,
+    balance_trace: Vec<BalanceSample>,
+    first_step_s: Option<f64>,
+    push: Option<PushSchedule>,
+    balance: BalanceAccumulator,
 }
 
 impl LoopState {
@@ -326,6 +572,7 @@ impl LoopState {
         let total = started.elapsed();
         match result {
             Ok(compute) => {
+                self.tick_ns.push(compute.as_nanos() as u64);
                 self.controller_time += compute;
                 self.physics_time += total.saturating_sub(compute);
                 Ok(())
@@ -340,6 +587,19 @@ impl LoopState {
             Err(TickError::Sim(error)) => {
                 panic!("the simulator refused a controller command: {error}")
             }
+        }
+    }
+
+    /// The first step, the balance tracking and the push, after a tick of the walk.
+    fn observe_walk(&mut self, sim: &mut MujocoSim, status: &ControllerStatus, dt: f64) {
+        let feet_down = status.contacts[EndEffector::LeftFoot as usize]
+            && status.contacts[EndEffector::RightFoot as usize];
+        if !feet_down && self.first_step_s.is_none() {
+            self.first_step_s = Some(sim.time());
+        }
+        self.balance.observe(status, sim.measurement().com, dt);
+        if let Some(push) = &mut self.push {
+            sim.set_pelvis_force(push.force(status.phase, sim.time()));
         }
     }
 

@@ -1,9 +1,9 @@
 //! The controller walks without falling under rigid-body physics: `daemon::controller` in closed
 //! loop with MuJoCo (`walk_bench::physics`), 500 Hz control, 1 ms physics steps, measurement
 //! from the simulated FT sensors, joint encoders and IMU. Each test walks forward (1 m for every
-//! robot and affordance set, 5 m feet-only per robot) and requires `done` with no fall (base
-//! height, torso tilt), the feet on their final targets, and the controller's estimate close to
-//! the simulator's truth. The seeds are fixed; `walkctl evaluate --physics mujoco` runs the
+//! robot and affordance set, 5 m feet-only per robot; the dynamic gait on JVRC-1, 1 m and 5 m)
+//! and requires `done` with no fall (base height, torso tilt), the feet on their final targets,
+//! and the controller's estimate close to the simulator's truth. The seeds are fixed; `walkctl evaluate --physics mujoco` runs the
 //! paper's ten-seed matrix over processes (docs/evaluation.md).
 //!
 //! Needs the `mujoco` feature of walk-bench (scripts/test.sh enables it). Built without it, the
@@ -195,6 +195,7 @@ mod walks {
             let report = walk_sequence(
                 robot_model.clone(),
                 controller,
+                &daemon::controller::GaitConfig::default(),
                 &sequence,
                 &PhysicsWalkOptions::default(),
             )
@@ -203,6 +204,71 @@ mod walks {
             print_report(&name, 1.0, &report);
             assert_walked(&name, &report, 1.0);
         }
+    }
+
+    /// How far the estimate may drift from the simulator, and the feet end from their targets,
+    /// in a dynamic walk (m): at its speed the stance feet slip about their vertical axes and the
+    /// heading error adds up (up to 0.10 m measured in the ten 5 m feet-only walks).
+    const MAX_DYNAMIC_DRIFT_M: f64 = 0.15;
+
+    /// The dynamic gait on JVRC-1, feet only, generator seeds 0 and 1: `done` without a fall,
+    /// the feet moved, the estimate and the final soles within [`MAX_DYNAMIC_DRIFT_M`] of the
+    /// simulator and the targets, and at least `min_speed` (distance over the time from the first
+    /// step to `done`).
+    fn check_dynamic(distance: f64, min_speed: f64) {
+        let options = PhysicsWalkOptions::dynamic();
+        for seed in [0, 1] {
+            let report = walk_distance(
+                &config("jvrc1"),
+                None,
+                distance,
+                AffordanceSet::Feet,
+                seed,
+                &options,
+            )
+            .unwrap_or_else(|e| panic!("jvrc1 dynamic seed {seed}: {e:#}"));
+            let name = format!("jvrc1 dynamic seed {seed}");
+            print_report(&name, distance, &report);
+            assert!(
+                report.success(),
+                "{name}: ended `{}` at {:.2} s, stance {} of {}",
+                report.outcome.label(),
+                report.sim_s,
+                report.stance_reached,
+                report.stances
+            );
+            assert!(
+                report.distance_m > 0.8 * distance,
+                "{name}: {:.3} m",
+                report.distance_m
+            );
+            assert!(
+                report.drift_m() < MAX_DYNAMIC_DRIFT_M,
+                "{name}: drift {:.3} m",
+                report.drift_m()
+            );
+            assert!(
+                report.final_position_error_m < MAX_DYNAMIC_DRIFT_M,
+                "{name}: final error {:.3} m",
+                report.final_position_error_m
+            );
+            let speed = report.speed_m_s().expect("the robot stepped");
+            eprintln!(
+                "{name}: {speed:.3} m/s, tick p50 {:.1} µs p99 {:.1} µs, ZMP error rms {:.3} m",
+                report.tick_us[0], report.tick_us[1], report.balance.zmp_rms_m
+            );
+            assert!(speed >= min_speed, "{name}: {speed:.3} m/s");
+        }
+    }
+
+    #[test]
+    fn jvrc1_walks_1m_dynamically() {
+        check_dynamic(1.0, 0.12);
+    }
+
+    #[test]
+    fn jvrc1_walks_5m_dynamically() {
+        check_dynamic(5.0, 0.2);
     }
 
     #[test]

@@ -17,6 +17,11 @@
 //!   each FT frame origin in world-aligned axes (the force the ground exerts on the robot).
 //! - **Safety metrics**: stability margin (signed distance of the CoM ground projection to the
 //!   support polygon; negative = fall), contact slip, penetration, joint limit violations.
+//! - **Dynamic walks** ([`SimOptions::judge_by_zmp`]): a walk that is not statically stable is
+//!   judged by its ZMP, `p = c − (z_c / g) c̈` (`c̈` by finite differences over the last steps,
+//!   low-pass filtered; `z_c` the CoM height above the ground), instead of the CoM; the
+//!   synthetic forces carry `m (g + z̈)` and are split between the feet so that their centres of
+//!   pressure make that ZMP.
 //!
 //! [`Simulator`] is the interface every simulated robot offers (this one and MuJoCo's), so one
 //! closed loop and one adapter wrapper serve both.
@@ -46,6 +51,12 @@ pub struct SimOptions {
     pub release_tolerance: f64,
     /// Ground stiffness that shifts load onto a foot pressed into the ground (N/m).
     pub ground_stiffness: f64,
+    /// Judge stability, and synthesise the forces, from the ZMP of the CoM's motion instead of
+    /// the CoM (for dynamic walks, whose CoM leaves the support polygon by design).
+    pub judge_by_zmp: bool,
+    /// Time constant of the low-pass filter on the CoM acceleration of the ZMP (s). The ideal
+    /// servos change velocity from one step to the next, which a real robot's inertia smooths.
+    pub zmp_filter_s: f64,
 }
 
 impl Default for SimOptions {
@@ -55,6 +66,8 @@ impl Default for SimOptions {
             touchdown_tolerance: 1e-4,
             release_tolerance: 5e-4,
             ground_stiffness: 2e6,
+            judge_by_zmp: false,
+            zmp_filter_s: 0.02,
         }
     }
 }
@@ -171,7 +184,8 @@ impl From<JointVectorError> for SimError {
 /// Safety metrics of the current state; the simulator also keeps their worst values.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SafetyMetrics {
-    /// Signed distance of the CoM ground projection to the support polygon (m, < 0 = falling).
+    /// Signed distance of the CoM ground projection (the ZMP with [`SimOptions::judge_by_zmp`])
+    /// to the support polygon (m, < 0 = falling).
     pub stability_margin: f64,
     /// Largest horizontal displacement of a foot in contact from its touchdown pose (m).
     pub contact_slip: f64,
@@ -245,6 +259,11 @@ pub struct KinematicSim {
     corners: [[f64; 2]; 8],
     /// Simulated time since the start (s).
     time: f64,
+    /// The CoM of the last two states and the step between them, for the ZMP's acceleration.
+    com_history: [Option<Vector3<f64>>; 2],
+    last_dt: f64,
+    /// The filtered CoM acceleration.
+    com_acceleration: Vector3<f64>,
 }
 
 impl KinematicSim {
@@ -282,6 +301,9 @@ impl KinematicSim {
             summary: SafetySummary::default(),
             corners: [[0.0; 2]; 8],
             time: 0.0,
+            com_history: [None; 2],
+            last_dt: 0.0,
+            com_acceleration: Vector3::zeros(),
         };
         let mut lowest = f64::INFINITY;
         for (slot, foot) in FEET.iter().enumerate() {
@@ -294,7 +316,7 @@ impl KinematicSim {
         if sim.anchors.iter().all(Option::is_none) {
             return Err(SimError::NotStanding { lowest_m: lowest });
         }
-        sim.finish_step(0);
+        sim.finish_step(0, 0.0);
         Ok(sim)
     }
 
@@ -320,7 +342,8 @@ impl KinematicSim {
             - self.options.ground_height
     }
 
-    /// Lever-rule share of the weight carried by each anchored foot (sums to 1 when any is anchored).
+    /// Lever-rule share of the weight carried by each anchored foot when the resultant acts at
+    /// `com`'s ground projection (sums to 1 when any is anchored).
     fn lever_shares(&self, com: &Vector3<f64>) -> [f64; 2] {
         match self.anchors {
             [Some(_), None] => [1.0, 0.0],
@@ -410,11 +433,34 @@ impl KinematicSim {
         }
     }
 
-    /// Forces, metrics and the measurement record of the new state.
-    fn finish_step(&mut self, limit_violations: usize) {
+    /// The point the ground reaction acts at (the CoM's ground projection, or the ZMP of its
+    /// motion with `judge_by_zmp`) and the total normal force, in the state after a step of `dt`.
+    fn resultant(&mut self, com: &Vector3<f64>, dt: f64) -> (Vector3<f64>, f64) {
+        let mass = self.robot.model.total_mass();
+        let history = self.com_history;
+        self.com_history = [Some(*com), history[0]];
+        let previous_dt = std::mem::replace(&mut self.last_dt, dt);
+        let (true, [Some(last), Some(before)]) = (self.options.judge_by_zmp, history) else {
+            return (*com, mass * GRAVITY);
+        };
+        if dt <= 0.0 || previous_dt <= 0.0 {
+            return (*com, mass * GRAVITY);
+        }
+        let raw = ((com - last) / dt - (last - before) / previous_dt) / dt;
+        let blend = dt / (self.options.zmp_filter_s + dt);
+        self.com_acceleration += (raw - self.com_acceleration) * blend;
+        let acceleration = self.com_acceleration;
+        let height = com.z - self.options.ground_height;
+        let mut zmp = com - acceleration * (height / GRAVITY);
+        zmp.z = com.z;
+        (zmp, mass * (GRAVITY + acceleration.z).max(0.0))
+    }
+
+    /// Forces, metrics and the measurement record of the new state, `dt` after the last.
+    fn finish_step(&mut self, limit_violations: usize, dt: f64) {
         let com = self.kinematics.com();
-        let weight = self.robot.model.total_mass() * GRAVITY;
-        let shares = self.lever_shares(&com);
+        let (support_point, weight) = self.resultant(&com, dt);
+        let shares = self.lever_shares(&support_point);
         let mut loads = [0.0; 2];
         let mut slip: f64 = 0.0;
         let mut corner_count = 0;
@@ -443,7 +489,11 @@ impl KinematicSim {
                 loaded_centre += loads[slot] / total * self.pose(*foot).translation.vector;
             }
         }
-        let cop_offset = Vector3::new(com.x - loaded_centre.x, com.y - loaded_centre.y, 0.0);
+        let cop_offset = Vector3::new(
+            support_point.x - loaded_centre.x,
+            support_point.y - loaded_centre.y,
+            0.0,
+        );
         let mut wrenches = [[0.0; 6]; 4];
         for (slot, foot) in FEET.iter().enumerate() {
             if self.anchors[slot].is_none() || total <= 0.0 {
@@ -463,7 +513,7 @@ impl KinematicSim {
             .map(|foot| (-self.lowest_corner_height(*foot)).max(0.0))
             .fold(0.0, f64::max);
         let safety = SafetyMetrics {
-            stability_margin: polygon.signed_distance([com.x, com.y]),
+            stability_margin: polygon.signed_distance([support_point.x, support_point.y]),
             contact_slip: slip,
             penetration,
             limit_violations,

@@ -63,7 +63,7 @@ impl Simulator for KinematicSim {
         }
         self.place_base();
         self.update_contacts();
-        self.finish_step(violations);
+        self.finish_step(violations, dt);
         self.time += dt;
         Ok(())
     }

@@ -1,10 +1,9 @@
 //! Behaviour of the kinematic simulator on the vendored robots.
 
-use kinematic_sim::Simulator;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use kinematic_sim::{KinematicSim, SimError};
+use kinematic_sim::{KinematicSim, SimError, SimOptions, Simulator};
 use kinematics::ground::GRAVITY;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
@@ -184,6 +183,67 @@ fn moving_every_joint_in_single_support_keeps_the_stance_foot_in_place() {
             sim.measurement().safety.contact_slip < 1e-12,
             "step {k}: slip {}",
             sim.measurement().safety.contact_slip
+        );
+    }
+}
+
+#[test]
+fn a_dynamic_walk_is_judged_by_the_zmp_of_its_com_motion() {
+    let robot = robot("jvrc1");
+    let options = SimOptions {
+        judge_by_zmp: true,
+        zmp_filter_s: 0.0,
+        ..SimOptions::default()
+    };
+    let mut sim = KinematicSim::with_options(robot.clone(), robot.standing.clone(), options)
+        .expect("standing");
+    // Both ankles pitch the body back and forth at 1.5 Hz: the CoM accelerates along x.
+    let ankles = [
+        leg_joint(&robot, true, "ankle_p"),
+        leg_joint(&robot, false, "ankle_p"),
+    ];
+    let dt = 0.002;
+    let mut kinematics = Kinematics::new(&robot.model);
+    let mut coms = Vec::new();
+    for k in 0..300 {
+        let mut q = robot.standing.joints.clone();
+        let swing = 0.005 * (std::f64::consts::TAU * 1.5 * f64::from(k) * dt).sin();
+        for &j in &ankles {
+            q[j] += swing;
+        }
+        sim.step(q.as_slice(), q.as_slice(), dt).unwrap();
+        let m = sim.measurement();
+        coms.push(m.com);
+        if coms.len() < 3 {
+            continue;
+        }
+        let n = coms.len();
+        let acceleration = (coms[n - 1] - 2.0 * coms[n - 2] + coms[n - 3]) / (dt * dt);
+        let zmp = coms[n - 1].x - acceleration.x * coms[n - 1].z / GRAVITY;
+        // The resultant of the synthetic wrenches acts at that ZMP with m (g + z̈).
+        kinematics.update(&robot.model, sim.configuration());
+        let (mut moment, mut normal) = (0.0, 0.0);
+        for (slot, foot) in [EndEffector::LeftFoot, EndEffector::RightFoot]
+            .iter()
+            .enumerate()
+        {
+            let w = m.wrenches[*foot as usize];
+            let o = kinematics
+                .frame_pose(&robot.model, robot.ft_sensors[slot])
+                .translation
+                .vector;
+            moment += o.x * w[2] - w[4] - o.z * w[0];
+            normal += w[2];
+        }
+        let weight = robot.model.total_mass() * (GRAVITY + acceleration.z);
+        assert!(
+            (normal - weight).abs() < 1e-6 * weight,
+            "tick {k}: {normal} vs {weight}"
+        );
+        assert!((moment / normal - zmp).abs() < 1e-9, "tick {k}");
+        assert!(
+            m.safety.stability_margin > 0.0,
+            "tick {k}: the ZMP stays on the feet"
         );
     }
 }

@@ -1,4 +1,5 @@
-//! Algorithm 1's parameters: the `[postprocess]` section of a robot config.
+//! Algorithm 1's parameters: the `[postprocess]` section of a robot config, with the
+//! `[postprocess.dynamic]` overrides a dynamic walk post-processes with.
 
 use std::path::{Path, PathBuf};
 
@@ -15,6 +16,42 @@ pub enum ContactUnification {
     First,
     /// Every stance of the run takes the mean of the run's poses (the interpolation variant).
     Mean,
+}
+
+/// How a sequence is walked: each gait post-processes with its own limits (a dynamic walk
+/// takes longer steps than a statically stable one), so the choice is made before
+/// post-processing and travels with the sequence to the controller.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Gait {
+    /// Quasi-static: the CoM stays over the support polygon; contact changes wait for targets
+    /// and force-torque confirmation (the paper's controller, the safe fallback).
+    #[default]
+    Static,
+    /// Timed steps on a linear-inverted-pendulum walking pattern with a stabilizer.
+    Dynamic,
+}
+
+impl Gait {
+    /// Lower-case name (`static`, `dynamic`), as in the configs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Static => "static",
+            Self::Dynamic => "dynamic",
+        }
+    }
+}
+
+impl std::str::FromStr for Gait {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        match text {
+            "static" => Ok(Self::Static),
+            "dynamic" => Ok(Self::Dynamic),
+            other => Err(format!("unknown gait `{other}` (static or dynamic)")),
+        }
+    }
 }
 
 /// Parameters of Algorithm 1 (names as in the paper). Lengths in metres, angles in radians.
@@ -53,9 +90,13 @@ pub enum ParamsError {
     /// No `[postprocess]` table.
     #[error("{path}: missing section [postprocess]")]
     MissingSection { path: PathBuf },
-    /// A missing, unknown or mistyped key in `[postprocess]`.
-    #[error("{path}: [postprocess]: {message}")]
-    Key { path: PathBuf, message: String },
+    /// A missing, unknown or mistyped key in `[postprocess]` or `[postprocess.dynamic]`.
+    #[error("{path}: [{section}]: {message}")]
+    Key {
+        path: PathBuf,
+        section: &'static str,
+        message: String,
+    },
     /// A value outside its domain.
     #[error("{origin}: [postprocess] key `{key}`: {message}")]
     Invalid {
@@ -65,8 +106,11 @@ pub enum ParamsError {
     },
 }
 
+/// The table of per-gait overrides inside `[postprocess]`.
+const DYNAMIC_OVERRIDES: &str = "dynamic";
+
 impl PostProcessParams {
-    /// Reads the `[postprocess]` section of the robot config at `path`.
+    /// Reads the `[postprocess]` section of the robot config at `path` (the static gait's).
     pub fn from_config_path(path: &Path) -> Result<Self, ParamsError> {
         Self::from_config(&ConfigFile::load(path)?)
     }
@@ -76,23 +120,56 @@ impl PostProcessParams {
         Self::from_config(&ConfigFile::parse(text, path)?)
     }
 
-    /// Reads the `[postprocess]` section of a loaded robot config.
+    /// Reads the `[postprocess]` section of a loaded robot config (the static gait's).
     pub fn from_config(file: &ConfigFile) -> Result<Self, ParamsError> {
+        Self::from_config_for(file, Gait::Static)
+    }
+
+    /// Reads the parameters `gait` post-processes with: `[postprocess]`, for the dynamic gait
+    /// with the keys of `[postprocess.dynamic]` replacing their `[postprocess]` values. The
+    /// overrides are checked whichever gait is asked for, so a typo in them never waits for a
+    /// dynamic walk.
+    pub fn from_config_for(file: &ConfigFile, gait: Gait) -> Result<Self, ParamsError> {
         let path = file.path();
-        let section = file
+        let mut section = file
             .section("postprocess")
+            .and_then(toml::Value::as_table)
             .ok_or_else(|| ParamsError::MissingSection {
                 path: path.to_owned(),
             })?
             .clone();
-        let params: Self = section
-            .try_into()
-            .map_err(|e: toml::de::Error| ParamsError::Key {
-                path: path.to_owned(),
-                message: e.message().to_owned(),
-            })?;
-        params.validate(&file.origin())?;
-        Ok(params)
+        let overrides = match section.remove(DYNAMIC_OVERRIDES) {
+            None => toml::Table::new(),
+            Some(toml::Value::Table(overrides)) => overrides,
+            Some(_) => {
+                return Err(ParamsError::Key {
+                    path: path.to_owned(),
+                    section: "postprocess",
+                    message: format!("`{DYNAMIC_OVERRIDES}` must be a table of overrides"),
+                });
+            }
+        };
+        let parse = |table: toml::Table, section: &'static str, origin: String| {
+            let params: Self =
+                toml::Value::Table(table)
+                    .try_into()
+                    .map_err(|e: toml::de::Error| ParamsError::Key {
+                        path: path.to_owned(),
+                        section,
+                        message: e.message().to_owned(),
+                    })?;
+            params.validate(&origin)?;
+            Ok::<_, ParamsError>(params)
+        };
+        let origin = file.origin();
+        let static_params = parse(section.clone(), "postprocess", origin.clone())?;
+        section.extend(overrides);
+        let dynamic_origin = format!("{origin} (with [postprocess.{DYNAMIC_OVERRIDES}])");
+        let dynamic_params = parse(section, "postprocess.dynamic", dynamic_origin)?;
+        Ok(match gait {
+            Gait::Static => static_params,
+            Gait::Dynamic => dynamic_params,
+        })
     }
 
     /// Checks every value's domain; `origin` names the source in the error (file or "--option").
@@ -170,6 +247,40 @@ mod tests {
         let message = err.to_string();
         assert!(
             message.contains("r.toml") && message.contains("smax"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn dynamic_overrides_replace_their_keys_only() {
+        let text = format!("{SECTION}\n[postprocess.dynamic]\ns_max = 0.45\nscf = 0.3\n");
+        let path = Path::new("r.toml");
+        let dynamic = PostProcessParams::from_config_for(
+            &ConfigFile::parse(&text, path).unwrap(),
+            Gait::Dynamic,
+        )
+        .unwrap();
+        assert_eq!(
+            (dynamic.s_max, dynamic.scf, dynamic.h_max),
+            (0.45, 0.3, 0.1)
+        );
+        let fixed = PostProcessParams::from_config_str(&text, path).unwrap();
+        assert_eq!((fixed.s_max, fixed.scf), (0.3, 0.4));
+        let without = PostProcessParams::from_config_for(
+            &ConfigFile::parse(SECTION, path).unwrap(),
+            Gait::Dynamic,
+        )
+        .unwrap();
+        assert_eq!(without, fixed);
+    }
+
+    #[test]
+    fn an_unknown_override_names_its_table_for_every_gait() {
+        let text = format!("{SECTION}\n[postprocess.dynamic]\nsmax = 0.45\n");
+        let err = PostProcessParams::from_config_str(&text, Path::new("r.toml")).unwrap_err();
+        let message = err.to_string();
+        assert!(
+            message.contains("[postprocess.dynamic]") && message.contains("smax"),
             "{message}"
         );
     }

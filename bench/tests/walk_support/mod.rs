@@ -6,8 +6,8 @@ use kinematic_sim::Simulator;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use daemon::controller::{Controller, ControllerConfig, Phase, SolverKind};
-use kinematic_sim::KinematicSim;
+use daemon::controller::{Controller, ControllerConfig, Gait, GaitConfig, Phase, SolverKind};
+use kinematic_sim::{KinematicSim, SimOptions};
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Translation3};
@@ -24,6 +24,17 @@ pub fn config_path(name: &str) -> PathBuf {
 /// The vendored robot `name`.
 pub fn robot(name: &str) -> Arc<Robot> {
     Arc::new(Robot::load(&config_path(name), None).expect("vendored robot loads"))
+}
+
+/// The `[gait]` section of `name`'s config, for the kinematic simulator: the parts of the
+/// stabilizer that need forces and inertia (foot damping, tilt damping) switched off, as an ideal
+/// kinematic robot has neither: its synthetic centre of pressure follows the commanded motion.
+pub fn kinematic_gait_config(name: &str) -> GaitConfig {
+    let mut gaits = GaitConfig::from_config_file(&config_path(name)).expect("gait config parses");
+    let stabilizer = &mut gaits.dynamic.as_mut().expect("a dynamic gait").stabilizer;
+    stabilizer.foot_damping = false;
+    stabilizer.tilt_damping = false;
+    gaits
 }
 
 /// The `[controller]` section of `name`'s config.
@@ -188,9 +199,28 @@ impl Harness {
 
     /// [`Harness::new`] with `config` instead of the robot's `[controller]` section.
     pub fn with_config(name: &str, config: ControllerConfig, rate_hz: f64) -> Self {
+        Self::with_sim_options(name, config, SimOptions::default(), rate_hz)
+    }
+
+    /// A standing robot `name` for dynamic walks: the simulator judges by the ZMP.
+    pub fn dynamic(name: &str, rate_hz: f64) -> Self {
+        let options = SimOptions {
+            judge_by_zmp: true,
+            ..SimOptions::default()
+        };
+        Self::with_sim_options(name, controller_config(name), options, rate_hz)
+    }
+
+    fn with_sim_options(
+        name: &str,
+        config: ControllerConfig,
+        options: SimOptions,
+        rate_hz: f64,
+    ) -> Self {
         let robot = robot(name);
         let controller = Controller::new(robot.clone(), config, SolverKind::Dense).unwrap();
-        let sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
+        let sim =
+            KinematicSim::with_options(robot.clone(), robot.standing.clone(), options).unwrap();
         let closed = ClosedLoop::new(controller, sim, rate_hz);
         Self {
             dt: closed.dt(),
@@ -203,6 +233,15 @@ impl Harness {
     pub fn start(&mut self, sequence: &PostProcessedSequence) {
         let config = controller_config(&self.robot.name);
         let prepared = Controller::prepare(&self.robot, &config, sequence).unwrap();
+        assert!(self.closed.controller.start(Box::new(prepared)).is_ok());
+    }
+
+    /// Prepares `sequence` for the dynamic gait with `gaits` and starts it.
+    pub fn start_dynamic(&mut self, sequence: &PostProcessedSequence, gaits: &GaitConfig) {
+        let config = controller_config(&self.robot.name);
+        let prepared =
+            Controller::prepare_gait(&self.robot, &config, gaits, sequence, Gait::Dynamic)
+                .expect("sequence accepted");
         assert!(self.closed.controller.start(Box::new(prepared)).is_ok());
     }
 

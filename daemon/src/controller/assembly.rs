@@ -2,8 +2,10 @@
 //!
 //! ```text
 //! min  Σ_k w_k ‖J_k ν − v*_k‖² + λ‖ν‖²        v*_k = feed-forward + K_k · error_k
-//! s.t. J_c ν = c                               feet in contact (c: bounded anchor correction)
+//! s.t. J_c ν = c + v_c                         feet in contact (c: bounded anchor correction,
+//!                                              v_c: the dynamic gait's foot compliance)
 //!      n_eᵀ J_com,xy ν ≤ k_s (d_e − m − n_eᵀ c) CoM stays in the support polygon shrunk by m
+//!                                              (static gait only)
 //!      q̇ within velocity limits and (q_min + margin − q_cmd)/dt ≤ q̇ ≤ (q_max − margin − q_cmd)/dt
 //!      |v_base|, |ω_base| ≤ max_base_speed, |ω_x|, |ω_y| ≤ max_base_tilt_speed (roll/pitch rate)
 //! ```
@@ -13,7 +15,8 @@
 //! correction would feed the servo's tracking lag back into the integrated command and make a
 //! joint resting at its bound oscillate.
 //!
-//! Tasks: CoM x/y, end-effector poses, upright base, posture. Jacobian blocks are accumulated
+//! Tasks: CoM x/y (and z at a constant height in the dynamic gait, whose ZMP-feasible CoM
+//! set-point replaces the polygon constraint), end-effector poses, upright base, posture. Jacobian blocks are accumulated
 //! over their structurally non-zero columns only, so a foot task costs a few hundred flops.
 //! Everything is preallocated at construction.
 
@@ -25,7 +28,7 @@ use nalgebra::{DMatrix, DVector, Isometry3, UnitQuaternion, Vector3};
 use kinematics::ground::{MAX_SUPPORT_POINTS, SupportPolygon, sole_corners};
 
 use super::config::ControllerConfig;
-use super::machine::{PoseTarget, Targets};
+use super::machine::{Balance, PoseTarget, Targets};
 use crate::qp::QpProblem;
 
 /// Equality rows: six per foot in contact.
@@ -120,8 +123,13 @@ impl QpAssembler {
             .iter()
             .filter(|f| targets.contacts[**f as usize])
             .count();
-        self.polygon_from_contacts(robot, targets);
-        let m_ineq = self.polygon.edge_count();
+        let m_ineq = match targets.balance {
+            Balance::SupportPolygon => {
+                self.polygon_from_contacts(robot, targets);
+                self.polygon.edge_count()
+            }
+            Balance::ComHeight(_) => 0,
+        };
         self.problem
             .set_active_rows(6 * feet_in_contact, m_ineq)
             .expect("row counts within the preallocated capacity");
@@ -133,18 +141,23 @@ impl QpAssembler {
             p[(i, i)] = config.regularization;
         }
 
-        // CoM x/y.
+        // CoM x/y, and its height when the gait holds it.
         kinematics.com_jacobian(model, &mut self.com_jacobian);
         let com = kinematics.com();
+        let (com_rows, height) = match targets.balance {
+            Balance::SupportPolygon => (2, com.z),
+            Balance::ComHeight(height) => (3, height),
+        };
         let com_velocity = [
             targets.com_velocity.x + config.com_gain * (targets.com.x - com.x),
             targets.com_velocity.y + config.com_gain * (targets.com.y - com.y),
+            config.com_gain * (height - com.z),
         ];
         add_task(
             &mut p,
             &mut q,
             &self.com_jacobian,
-            2,
+            com_rows,
             &self.all_columns,
             config.com_weight,
             &com_velocity,
@@ -222,8 +235,9 @@ impl QpAssembler {
             let scale = speed_scale(&correction[..3], config.max_anchor_correction_speed).min(
                 speed_scale(&correction[3..], config.max_anchor_correction_angular_speed),
             );
+            let compliance = &targets.contact_velocity[foot as usize];
             for (k, value) in correction.iter().enumerate() {
-                b_eq[row + k] = value * scale;
+                b_eq[row + k] = value * scale + compliance[k];
             }
             row += 6;
         }

@@ -6,6 +6,9 @@ use std::path::Path;
 use kinematics::{ConfigFile, ConfigFileError};
 use serde::Deserialize;
 
+/// The section [`ControllerConfig`] is read from.
+const SECTION: &str = "controller";
+
 /// Controller tuning from the `[controller]` section; every key is optional (defaults below suit
 /// the vendored humanoids) and an unknown key is an error naming the file and key.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
@@ -184,25 +187,29 @@ impl Default for ControllerConfig {
     }
 }
 
-/// Why the `[controller]` section could not be read.
+/// Why a section of a robot config (`[controller]`, `[gait]`, ...) could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     /// The config file could not be read or parsed.
     #[error(transparent)]
     File(#[from] ConfigFileError),
-    /// The `[controller]` section is missing, has an unknown key or a badly typed value.
-    #[error("{origin}: [controller]: {message}")]
+    /// The section is missing, has an unknown key or a badly typed value.
+    #[error("{origin}: [{section}]: {message}")]
     Section {
         /// File (or "<table>") the section came from.
         origin: String,
+        /// The section's name (`controller`, `gait.dynamic`, ...).
+        section: &'static str,
         /// What is wrong, naming the key.
         message: String,
     },
     /// A value is out of its meaningful range.
-    #[error("{origin}: [controller] {key} = {value}: {requirement}")]
+    #[error("{origin}: [{section}] {key} = {value}: {requirement}")]
     Value {
         /// File (or "<table>") the section came from.
         origin: String,
+        /// The section's name.
+        section: &'static str,
         /// The offending key.
         key: &'static str,
         /// Its value.
@@ -221,18 +228,18 @@ impl ControllerConfig {
     /// Reads the `[controller]` section of a loaded robot config.
     pub fn from_config(file: &ConfigFile) -> Result<Self, ConfigError> {
         let origin = file.origin();
-        let section = file
-            .section("controller")
-            .ok_or_else(|| ConfigError::Section {
-                origin: origin.clone(),
-                message: "section missing".to_owned(),
-            })?;
+        let section = file.section(SECTION).ok_or_else(|| ConfigError::Section {
+            origin: origin.clone(),
+            section: SECTION,
+            message: "section missing".to_owned(),
+        })?;
         let config: Self =
             section
                 .clone()
                 .try_into()
                 .map_err(|e: toml::de::Error| ConfigError::Section {
                     origin: origin.clone(),
+                    section: SECTION,
                     message: e.message().to_owned(),
                 })?;
         config.validate(&origin)?;
@@ -308,6 +315,7 @@ impl ControllerConfig {
         ];
         let fail = |key, value, requirement| ConfigError::Value {
             origin: origin.to_owned(),
+            section: SECTION,
             key,
             value,
             requirement,

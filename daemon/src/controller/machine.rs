@@ -52,6 +52,32 @@ pub(crate) struct Targets {
     pub end_effectors: [Option<PoseTarget>; 4],
     /// The foot being unloaded: out of the contact set but still on the ground.
     pub unloading: Option<EndEffector>,
+    /// How the QP keeps the robot balanced.
+    pub balance: Balance,
+    /// Velocities of the feet in contact on top of holding their anchors (linear xyz, angular
+    /// xyz, world; left, right): the dynamic gait's force and CoP compliance.
+    pub contact_velocity: [[f64; 6]; 2],
+}
+
+impl Targets {
+    /// World anchors of the feet in contact, for the estimator.
+    pub fn foot_anchors(&self) -> [Option<&Isometry3<f64>>; 2] {
+        FEET.map(|f| {
+            let e = f as usize;
+            self.contacts[e].then_some(&self.anchors[e])
+        })
+    }
+}
+
+/// How the QP keeps the robot balanced.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Balance {
+    /// The CoM ground projection stays inside the support polygon (the static gait); the CoM
+    /// height is free.
+    SupportPolygon,
+    /// The CoM set-point moves like a pendulum whose ZMP stays in the support (the dynamic
+    /// gait), so no polygon constraint; the CoM is held at this height (world z, m).
+    ComHeight(f64),
 }
 
 /// Result of one state-machine update.
@@ -128,6 +154,8 @@ impl StateMachine {
                 com_velocity: Vector2::zeros(),
                 end_effectors: [None; 4],
                 unloading: None,
+                balance: Balance::SupportPolygon,
+                contact_velocity: [[0.0; 6]; 2],
             },
         }
     }
@@ -142,17 +170,25 @@ impl StateMachine {
         }
     }
 
+    /// Takes over the contact set and anchors another gait's walk left: they are the support
+    /// for estimation and the start of the next walk. Feet in the air keep their last target.
+    pub fn adopt(&mut self, targets: &Targets) {
+        self.targets.contacts = targets.contacts;
+        self.targets.anchors = targets.anchors;
+        self.carried = [None; 4];
+        for foot in FEET {
+            let e = foot as usize;
+            self.free_targets[e] = if targets.contacts[e] {
+                None
+            } else {
+                targets.end_effectors[e].map(|target| target.pose)
+            };
+        }
+    }
+
     /// The live contact set and anchors (also used for estimation while holding).
     pub fn targets(&self) -> &Targets {
         &self.targets
-    }
-
-    /// World anchors of the feet in contact, for the estimator.
-    pub fn foot_anchors(&self) -> [Option<&Isometry3<f64>>; 2] {
-        FEET.map(|f| {
-            let e = f as usize;
-            self.targets.contacts[e].then_some(&self.targets.anchors[e])
-        })
     }
 
     /// The posture reference of the stance being moved towards.
@@ -363,6 +399,15 @@ impl StateMachine {
             }
             (phase, None) => unreachable!("phase {phase:?} needs an end-effector"),
             (Phase::None, _) => unreachable!("plans hold no empty phase"),
+            (
+                Phase::DoubleSupport
+                | Phase::SingleSupport
+                | Phase::LateTouchdown
+                | Phase::LateLiftOff,
+                _,
+            ) => {
+                unreachable!("static plans hold no dynamic-gait phase")
+            }
         };
         // However far a target, a phase that does not complete faults in bounded time.
         self.deadline = duration.min(c.max_phase_s) + timeout;
@@ -539,7 +584,7 @@ enum StepStatus {
 }
 
 /// The planar frame (x, y, yaw) of `pose`.
-fn heading_frame(pose: &Isometry3<f64>) -> Isometry3<f64> {
+pub(crate) fn heading_frame(pose: &Isometry3<f64>) -> Isometry3<f64> {
     planar_frame(std::iter::once(pose))
 }
 

@@ -30,9 +30,11 @@
 mod assembly;
 mod config;
 mod estimator;
+mod gait;
 mod machine;
 mod plan;
 mod sequence;
+mod sequencer;
 mod status;
 mod trajectory;
 
@@ -44,14 +46,19 @@ use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{DVector, Isometry3, UnitQuaternion};
 
 pub use config::{ConfigError, ControllerConfig};
+pub use gait::{DynamicGaitConfig, GaitConfig, StabilizerConfig};
 pub use sequence::{PreparedSequence, Refusal};
+pub use stance::Gait;
 pub use status::{
-    ControllerState, ControllerStatus, FaultCode, FaultDescription, MeasurementFault, Phase,
+    BalanceStatus, ControllerState, ControllerStatus, FaultCode, FaultDescription,
+    MeasurementFault, Phase,
 };
 
 use assembly::QpAssembler;
 use estimator::BaseEstimator;
-use machine::{Feedback, Progress, StateMachine};
+use gait::{DynamicPlan, Sensors};
+use machine::{Feedback, Progress};
+use sequencer::Sequencer;
 
 use crate::qp::{ClarabelSolver, DenseActiveSetSolver, QpError, QpProblem, QpSolver};
 
@@ -101,6 +108,8 @@ pub enum StartRefusal {
     NoMeasurement,
     /// The IMU shows the robot tilted beyond `tipping_detection_rad` from upright.
     NotUpright,
+    /// A dynamic walk must start on both feet, and the robot does not stand on them.
+    NotOnBothFeet,
 }
 
 impl StartRefusal {
@@ -115,6 +124,10 @@ impl StartRefusal {
             Self::NotUpright => {
                 "the robot is not upright (its IMU is tilted beyond tipping_detection_rad): \
                  stand it up first"
+            }
+            Self::NotOnBothFeet => {
+                "a dynamic walk starts on both feet, and the robot does not stand on both: \
+                 finish on both feet with a static walk first"
             }
         }
     }
@@ -186,7 +199,7 @@ pub struct Controller {
     kinematics: Kinematics,
     configuration: Configuration,
     estimator: BaseEstimator,
-    machine: StateMachine,
+    machine: Sequencer,
     assembler: QpAssembler,
     solution: Vec<f64>,
     poses: [Isometry3<f64>; 4],
@@ -225,7 +238,7 @@ impl Controller {
             kinematics: Kinematics::new(model),
             configuration: robot.standing.clone(),
             estimator: BaseEstimator::new(robot.standing.base),
-            machine: StateMachine::new(&config, robot.sole, weight),
+            machine: Sequencer::new(&config, robot.sole, weight),
             assembler: QpAssembler::new(&robot),
             solution: vec![0.0; nv],
             poses: [Isometry3::identity(); 4],
@@ -249,9 +262,29 @@ impl Controller {
         PreparedSequence::new(robot, config, seq)
     }
 
+    /// Non-RT: [`prepare`](Self::prepare) for `gait`; a dynamic walk is also planned here (its
+    /// footsteps and walking pattern), and refused when the config has no `[gait.dynamic]` or the
+    /// sequence does not end on both feet.
+    pub fn prepare_gait(
+        robot: &Robot,
+        config: &ControllerConfig,
+        gaits: &GaitConfig,
+        seq: &stance::PostProcessedSequence,
+        gait: Gait,
+    ) -> Result<PreparedSequence, Refusal> {
+        let mut prepared = PreparedSequence::new(robot, config, seq)?;
+        if gait == Gait::Dynamic {
+            let dynamic = gaits.dynamic().map_err(Refusal)?;
+            let plan = DynamicPlan::new(robot, &prepared.stances, dynamic)?;
+            prepared.dynamic = Some(Box::new(plan));
+        }
+        Ok(prepared)
+    }
+
     /// RT: begins executing `seq` (from the next tick) in Idle, Holding or Done, unless the
-    /// last measurement was refused or the IMU shows the robot tilted. Returns the previously held sequence (drop it off the RT
-    /// thread); gives `seq` back with the reason otherwise.
+    /// last measurement was refused, the IMU shows the robot tilted, or `seq` is dynamic and the
+    /// feet the robot stands on are not both its first stance's. Returns the previously held
+    /// sequence (drop it off the RT thread); gives `seq` back with the reason otherwise.
     #[allow(clippy::type_complexity)]
     pub fn start(
         &mut self,
@@ -262,6 +295,9 @@ impl Controller {
             ControllerState::Fault => Some(StartRefusal::Faulted),
             _ if self.measurement_refused => Some(StartRefusal::NoMeasurement),
             _ if !self.upright() => Some(StartRefusal::NotUpright),
+            _ if self.world_ready && !self.machine.on_both_feet_for(&seq) => {
+                Some(StartRefusal::NotOnBothFeet)
+            }
             _ => None,
         };
         if let Some(refusal) = refusal {
@@ -307,7 +343,19 @@ impl Controller {
             poses: &self.poses,
             normal_forces: measurement.wrenches.map(|w| w[2]),
         };
-        match self.machine.update(&feedback, dt) {
+        let (robot, kinematics) = (&self.robot, &self.kinematics);
+        let sensors = || Sensors {
+            wrenches: measurement.wrenches,
+            ft_origins: robot.ft_sensors.map(|frame| {
+                kinematics
+                    .frame_pose(&robot.model, frame)
+                    .translation
+                    .vector
+            }),
+            base_rotation: self.configuration.base.rotation,
+            imu: measurement.imu_orientation,
+        };
+        match self.machine.update(&feedback, sensors, dt) {
             Progress::Running => {}
             Progress::Done => {
                 // Keep holding the last command: it carries the servo offsets of the load.
@@ -327,7 +375,7 @@ impl Controller {
             .expect("executing implies a sequence");
         self.assembler.assemble(
             &self.robot,
-            &self.config,
+            &self.machine.qp_config(&self.config),
             &self.kinematics,
             &self.configuration,
             &self.last_command,
@@ -544,6 +592,7 @@ impl Controller {
         self.status.stance_count = count as u32;
         self.status.phase = self.machine.phase();
         self.status.contacts = self.machine.targets().contacts;
+        self.status.balance = *self.machine.balance();
     }
 
     /// Enters `Fault` with `code`; a fault already present is kept (it is the first cause).

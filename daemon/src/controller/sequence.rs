@@ -5,6 +5,7 @@ use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{DVector, Isometry3};
 
 use super::config::ControllerConfig;
+use super::gait::DynamicPlan;
 
 /// Tolerance on the posture's joint limits (rad): `q_S` from IK sits on a limit at most by round-off.
 const LIMIT_TOLERANCE: f64 = 1e-6;
@@ -30,9 +31,20 @@ pub(crate) struct PreparedStance {
 #[derive(Debug, Clone)]
 pub struct PreparedSequence {
     pub(crate) stances: Vec<PreparedStance>,
+    /// The dynamic gait's plan; `None` for the static gait.
+    pub(crate) dynamic: Option<Box<DynamicPlan>>,
 }
 
 impl PreparedSequence {
+    /// The gait the sequence is executed with.
+    pub fn gait(&self) -> stance::Gait {
+        if self.dynamic.is_some() {
+            stance::Gait::Dynamic
+        } else {
+            stance::Gait::Static
+        }
+    }
+
     /// Number of stances.
     pub fn len(&self) -> usize {
         self.stances.len()
@@ -109,7 +121,10 @@ impl PreparedSequence {
         }
         check_step_sizes(&stances, config.max_step_m)?;
         check_workspace(&stances, config)?;
-        Ok(Self { stances })
+        Ok(Self {
+            stances,
+            dynamic: None,
+        })
     }
 }
 

@@ -49,8 +49,19 @@ pub enum Phase {
     Lower,
     /// Moving a hand to its contact pose (hand contacts are confirmed by pose).
     Reach,
-    /// Centring the CoM in the final support before `Done`.
+    /// Centring the CoM in the final support before `Done` (dynamic gait: the pendulum comes to
+    /// rest over the final feet).
     Settle,
+    /// Dynamic gait: both feet carry the robot while the ZMP crosses to the next stance foot.
+    DoubleSupport,
+    /// Dynamic gait: one foot carries the robot while the other swings to its landing.
+    SingleSupport,
+    /// Dynamic gait: the swing ended without a touchdown; the foot keeps descending and the plan
+    /// waits, up to `late_touchdown_max_s`.
+    LateTouchdown,
+    /// Dynamic gait: the double support ended with the foot to lift still loaded; the plan waits,
+    /// up to `late_lift_off_max_s`.
+    LateLiftOff,
 }
 
 impl Phase {
@@ -65,6 +76,10 @@ impl Phase {
             Self::Lower => "lower",
             Self::Reach => "reach",
             Self::Settle => "settle",
+            Self::DoubleSupport => "double_support",
+            Self::SingleSupport => "single_support",
+            Self::LateTouchdown => "late_touchdown",
+            Self::LateLiftOff => "late_lift_off",
         }
     }
 }
@@ -92,6 +107,11 @@ pub enum FaultCode {
     Tipping,
     /// A phase did not reach its target within its planned duration plus the timeout.
     Timeout(Phase),
+    /// Dynamic gait: force-torque did not confirm a swing foot's touchdown within
+    /// `late_touchdown_max_s` of the planned instant.
+    MissedTouchdown,
+    /// Dynamic gait: a walk starts standing on both feet, and the robot did not.
+    NotOnBothFeet,
 }
 
 impl FaultCode {
@@ -118,7 +138,9 @@ impl FaultCode {
             Self::Timeout(Phase::Lower) => "timeout: touchdown never confirmed by force-torque",
             Self::Timeout(Phase::Reach) => "timeout: hand did not reach its contact",
             Self::Timeout(Phase::Settle) => "timeout: CoM did not settle",
-            Self::Timeout(Phase::None) => "timeout",
+            Self::Timeout(_) => "timeout",
+            Self::MissedTouchdown => "missed touchdown: force-torque never confirmed the landing",
+            Self::NotOnBothFeet => "a dynamic walk starts on both feet",
         }
     }
 
@@ -140,7 +162,9 @@ impl FaultCode {
             Self::Timeout(Phase::Lower) => "timeout_lower",
             Self::Timeout(Phase::Reach) => "timeout_reach",
             Self::Timeout(Phase::Settle) => "timeout_settle",
-            Self::Timeout(Phase::None) => "timeout",
+            Self::Timeout(_) => "timeout",
+            Self::MissedTouchdown => "missed_touchdown",
+            Self::NotOnBothFeet => "not_on_both_feet",
         }
     }
 }
@@ -251,4 +275,23 @@ pub struct ControllerStatus {
     pub qp_iterations: u32,
     /// Active inequality/box constraints at the last QP solution.
     pub qp_active_constraints: u32,
+    /// The dynamic gait's balance readings (zero otherwise).
+    pub balance: BalanceStatus,
+}
+
+/// What the dynamic gait's stabilizer sees and asks for, ground plane (x, y; m), world frame.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct BalanceStatus {
+    /// The walking pattern's ZMP.
+    pub zmp_reference: [f64; 2],
+    /// The stabilizer's desired ZMP (reference plus DCM feedback, inside the support).
+    pub zmp_desired: [f64; 2],
+    /// The ZMP from the ankle wrenches (NaN without enough load on the feet).
+    pub zmp_measured: [f64; 2],
+    /// The walking pattern's DCM.
+    pub dcm_reference: [f64; 2],
+    /// The DCM of the estimated CoM (corrected by the IMU tilt and the ZMP offset).
+    pub dcm_measured: [f64; 2],
+    /// The estimated CoM model error, true minus model (the ZMP offset).
+    pub com_offset: [f64; 2],
 }

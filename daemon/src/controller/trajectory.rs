@@ -14,7 +14,7 @@ pub(crate) enum Profile {
 
 impl Profile {
     /// (s, ds/dt) at time `t` of a motion lasting `duration`.
-    fn sample(self, t: f64, duration: f64) -> (f64, f64) {
+    pub fn sample(self, t: f64, duration: f64) -> (f64, f64) {
         if t >= duration {
             return (1.0, 0.0);
         }

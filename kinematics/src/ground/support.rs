@@ -153,6 +153,71 @@ impl SupportPolygon {
         [mean[0] + cx / (3.0 * area), mean[1] + cy / (3.0 * area)]
     }
 
+    /// The point of the polygon shrunk by `margin` nearest to `p` (`p` itself when inside): where
+    /// a point that must stay `margin` inside the support is clamped to. A polygon without an
+    /// interior (a point or a segment) is not shrunk; the empty polygon leaves `p` as it is.
+    pub fn nearest_inside(&self, p: [f64; 2], margin: f64) -> [f64; 2] {
+        if self.len == 0 {
+            return p;
+        }
+        if !self.has_area() {
+            return self.nearest_on_boundary(p);
+        }
+        let shrunk = self.shrunk(margin);
+        if shrunk.signed_distance(p) >= 0.0 {
+            p
+        } else {
+            shrunk.nearest_on_boundary(p)
+        }
+    }
+
+    /// The polygon with every edge moved `margin` inwards (the vertex mean if nothing remains).
+    fn shrunk(&self, margin: f64) -> SupportPolygon {
+        let mut shrunk = SupportPolygon::empty();
+        let n = self.len;
+        for i in 0..n {
+            let (a, b) = (self.edge((i + n - 1) % n), self.edge(i));
+            let (da, db) = (a.offset - margin, b.offset - margin);
+            let det = a.normal[0] * b.normal[1] - a.normal[1] * b.normal[0];
+            if det.abs() < 1e-12 {
+                continue;
+            }
+            shrunk.vertices[shrunk.len] = [
+                (da * b.normal[1] - db * a.normal[1]) / det,
+                (a.normal[0] * db - b.normal[0] * da) / det,
+            ];
+            shrunk.len += 1;
+        }
+        // Too large a margin turns the polygon inside out: its vertices then lie closer than
+        // `margin` to some edge.
+        let within_margin = (0..shrunk.len).all(|i| {
+            (0..n).all(|k| {
+                let edge = self.edge(k);
+                let v = shrunk.vertices[i];
+                edge.offset - (edge.normal[0] * v[0] + edge.normal[1] * v[1]) >= margin - 1e-9
+            })
+        });
+        if shrunk.len < 3 || !within_margin {
+            return SupportPolygon::from_points(&[self.centroid()]);
+        }
+        shrunk
+    }
+
+    /// The point of the boundary nearest to `p`.
+    fn nearest_on_boundary(&self, p: [f64; 2]) -> [f64; 2] {
+        let mut best = (f64::INFINITY, self.vertices[0]);
+        for i in 0..self.len {
+            let a = self.vertices[i];
+            let b = self.vertices[(i + 1) % self.len];
+            let q = segment_nearest(p, a, b);
+            let distance = (p[0] - q[0]).hypot(p[1] - q[1]);
+            if distance < best.0 {
+                best = (distance, q);
+            }
+        }
+        best.1
+    }
+
     /// Signed distance from `p` to the polygon boundary: positive inside (the stability margin),
     /// negative outside, `-inf` for the empty polygon.
     pub fn signed_distance(&self, p: [f64; 2]) -> f64 {
@@ -195,6 +260,12 @@ fn cross(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let q = segment_nearest(p, a, b);
+    (p[0] - q[0]).hypot(p[1] - q[1])
+}
+
+/// The point of the segment `ab` nearest to `p`.
+fn segment_nearest(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let length_squared = dx * dx + dy * dy;
     let t = if length_squared > 0.0 {
@@ -202,7 +273,7 @@ fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     } else {
         0.0
     };
-    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+    [a[0] + t * dx, a[1] + t * dy]
 }
 
 #[cfg(test)]
@@ -249,6 +320,24 @@ mod tests {
                 e.normal[0] * (v[0] + e.normal[0]) + e.normal[1] * (v[1] + e.normal[1]) > e.offset
             );
         }
+    }
+
+    #[test]
+    fn nearest_inside_clamps_onto_the_shrunk_polygon() {
+        let polygon = square();
+        assert_eq!(polygon.nearest_inside([0.5, 0.5], 0.1), [0.5, 0.5]);
+        let clamped = polygon.nearest_inside([2.0, 0.5], 0.1);
+        assert!((clamped[0] - 0.9).abs() < 1e-12 && (clamped[1] - 0.5).abs() < 1e-12);
+        let corner = polygon.nearest_inside([-1.0, -1.0], 0.1);
+        assert!((corner[0] - 0.1).abs() < 1e-12 && (corner[1] - 0.1).abs() < 1e-12);
+        // Inside but within the margin: moved to the margin.
+        let near_edge = polygon.nearest_inside([0.5, 0.95], 0.1);
+        assert!((near_edge[1] - 0.9).abs() < 1e-12);
+        // A margin larger than the polygon leaves its centre.
+        let centre = polygon.nearest_inside([3.0, 0.2], 0.7);
+        assert!((centre[0] - 0.5).abs() < 1e-12 && (centre[1] - 0.5).abs() < 1e-12);
+        let segment = SupportPolygon::from_points(&[[0.0, 0.0], [1.0, 0.0]]);
+        assert_eq!(segment.nearest_inside([0.5, 1.0], 0.1), [0.5, 0.0]);
     }
 
     #[test]

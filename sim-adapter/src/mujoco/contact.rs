@@ -20,6 +20,22 @@ pub(crate) struct FootContacts {
     pub penetration: f64,
 }
 
+impl FootContacts {
+    /// Adds `share` of `reading`, for the mean over a control period's physics steps (touching
+    /// in any of them, the deepest penetration).
+    pub fn add(&mut self, reading: &FootContacts, share: f64) {
+        for (sum, wrench) in self.wrenches.iter_mut().zip(&reading.wrenches) {
+            for (s, w) in sum.iter_mut().zip(wrench) {
+                *s += w * share;
+            }
+        }
+        for (any, touching) in self.touching.iter_mut().zip(reading.touching) {
+            *any |= touching;
+        }
+        self.penetration = self.penetration.max(reading.penetration);
+    }
+}
+
 /// MuJoCo ids the contact reading needs.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct FootIds {

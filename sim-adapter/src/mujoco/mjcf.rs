@@ -77,7 +77,7 @@ pub(crate) fn write(
         r#"    <geom name="floor" type="plane" size="0 0 1" contype="1"/>"#
     );
     let attachments = Attachments::collect(robot, bodies, o.sole_thickness)?;
-    write_body(&mut xml, robot, bodies, &attachments, 0, 2);
+    write_body(&mut xml, robot, bodies, &attachments, o, 0, 2);
     let _ = writeln!(xml, "  </worldbody>");
     let _ = writeln!(xml, "  <actuator>");
     for joint in robot.model.joint_names() {
@@ -187,6 +187,7 @@ fn write_body(
     robot: &Robot,
     bodies: &RigidBodies,
     attachments: &Attachments,
+    options: &MujocoOptions,
     index: usize,
     depth: usize,
 ) {
@@ -221,7 +222,7 @@ fn write_body(
             );
         }
     }
-    write_inertial(xml, &pad, &body.mass);
+    write_inertial(xml, &pad, &model_error(robot, bodies, index, options));
     for attachment in attachments.0.iter().filter(|a| a.body == index) {
         match attachment.kind {
             AttachmentKind::Site(name) => {
@@ -244,9 +245,27 @@ fn write_body(
         }
     }
     for child in (0..bodies.bodies.len()).filter(|&c| bodies.bodies[c].parent == Some(index)) {
-        write_body(xml, robot, bodies, attachments, child, depth + 1);
+        write_body(xml, robot, bodies, attachments, options, child, depth + 1);
     }
     let _ = writeln!(xml, "{pad}</body>");
+}
+
+/// Body `index`'s mass properties with the options' model error (`mass_scale`,
+/// `pelvis_com_offset`) applied.
+fn model_error(
+    robot: &Robot,
+    bodies: &RigidBodies,
+    index: usize,
+    options: &MujocoOptions,
+) -> MassProperties {
+    let mut mass = bodies.bodies[index].mass;
+    mass.mass *= options.mass_scale;
+    mass.inertia *= options.mass_scale;
+    let pelvis = bodies.links.get(robot.model.link_name(robot.base_link));
+    if pelvis.is_some_and(|link| link.body == index) {
+        mass.com += Vector3::from(options.pelvis_com_offset);
+    }
+    mass
 }
 
 fn write_inertial(xml: &mut String, pad: &str, mass: &MassProperties) {

@@ -54,7 +54,7 @@ pub struct MujocoSim {
     options: MujocoOptions,
     data: MjData<Box<MjModel>>,
     layout: Layout,
-    /// Contact readings of the last constraint solve.
+    /// Contact readings of the last constraint solve (or the last `step`'s mean).
     contacts: FootContacts,
     /// Sole pose of each foot when it last touched down (for the slip metric).
     anchors: [Option<Isometry3<f64>>; 2],
@@ -157,6 +157,14 @@ impl MujocoSim {
     pub fn has_fallen(&self) -> bool {
         self.base_height() < self.options.fall_height_fraction * self.initial_base_height
             || self.torso_tilt() > self.options.fall_tilt
+    }
+
+    /// Applies `force` (N, world frame) at the centre of mass of the pelvis (the body holding the
+    /// configured `base_link`) from the next step on, until changed; zero removes it. An
+    /// experiment's push.
+    pub fn set_pelvis_force(&mut self, force: Vector3<f64>) {
+        let body = self.layout.base_link_body;
+        self.data.xfrc_applied_mut()[body] = [force.x, force.y, force.z, 0.0, 0.0, 0.0];
     }
 
     /// Puts the robot in `initial`, at rest, and evaluates it.
@@ -354,6 +362,7 @@ fn check_options(options: &MujocoOptions) -> Result<(), MujocoError> {
     let o = options;
     let positive = [
         ("timestep", o.timestep),
+        ("mass_scale", o.mass_scale),
         ("servo_stiffness", o.servo_stiffness),
         ("sole_thickness", o.sole_thickness),
         ("contact_time_constant", o.contact_time_constant),
@@ -366,6 +375,8 @@ fn check_options(options: &MujocoOptions) -> Result<(), MujocoError> {
         ("friction", o.friction),
         ("fall_height_fraction", o.fall_height_fraction),
     ];
+    let offsets = o.pelvis_com_offset.map(|v| ("pelvis_com_offset", v));
+    require_all(&offsets, |_| true, "finite")?;
     require_all(&positive, |v| v > 0.0, "positive and finite")?;
     require_all(&non_negative, |v| v >= 0.0, "non-negative and finite")?;
     if o.contact_time_constant < 2.0 * o.timestep {
@@ -424,15 +435,22 @@ impl Simulator for MujocoSim {
             ctrl[2 * j + 1] = qd;
         }
         let warnings_before = self.fatal_warning_count();
+        let mut period = FootContacts::default();
         for substep in 0..substeps {
             // Forward dynamics of the current state, the constraint solve and the integration.
             self.data.step2();
-            if substep + 1 == substeps {
-                // The contact list, solved forces and poses still describe the same state here.
+            // The contact list, solved forces and poses still describe the same state here.
+            if self.options.average_ft_over_step {
+                let reading = contact::read(&self.data, &self.layout.feet);
+                period.add(&reading, 1.0 / substeps as f64);
+            } else if substep + 1 == substeps {
                 self.contacts = contact::read(&self.data, &self.layout.feet);
             }
             // Kinematics, collisions and position/velocity sensors of the new state.
             self.data.step1();
+        }
+        if self.options.average_ft_over_step && substeps > 0 {
+            self.contacts = period;
         }
         if substeps == 0 {
             return Ok(());

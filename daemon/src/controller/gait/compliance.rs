@@ -1,0 +1,237 @@
+//! Foot force and centre-of-pressure compliance for position-controlled joints (Kajita et al.
+//! 2010; Caron et al. 2019), as velocities of the feet in contact that the QP's contact
+//! constraints add to their hold.
+//!
+//! The desired ZMP is first split between the feet in contact: in double support by the lever
+//! rule along the line between the sole centres (normal-force shares), each foot's centre of
+//! pressure (CoP) being its centre moved by the desired ZMP's offset from that line, clamped into
+//! the sole; in single support the stance foot carries everything at the desired ZMP.
+//!
+//! - **Foot damping**: a foot turns about the horizontal axes so that its measured CoP moves to
+//!   the desired one: `ω_x = −A f_z (cop_d − cop_m)_y`, `ω_y = A f_z (cop_d − cop_m)_x` (A in
+//!   rad/s per N·m; the angular velocity pressing the side that should carry more), less `θ/τ`
+//!   of the rotation `θ` it has accumulated since the foot landed (a leak: a CoP error that the
+//!   ankle cannot remove does not wind it up to its limit). The sole is on the ground, so the
+//!   servos turn that into ankle torque.
+//! - **Force difference** (double support): the feet move vertically against each other,
+//!   `v = K (Δf_d − Δf_m)` with `Δf = f_left − f_right` (K in m/s per N): the left foot by
+//!   `−v/2`, the right by `+v/2`, so the foot that should carry more presses down.
+//! - **Tilt damping**: the robot rocks on its compliant soles (MuJoCo, JVRC-1: about 4 Hz in
+//!   pitch, 2 Hz in roll, excited by every lift-off and swing), which leg odometry cannot see and
+//!   which swings the ZMP by centimetres. For a body of inertia `I` about the sole on a contact of
+//!   rotational stiffness `k`, `I θ̈ = −k (θ − φ) + m g h θ` (θ: body tilt, φ: ankle angle), so an
+//!   ankle that turns against the body's tilt rate, `φ = −K_d θ̇` (IMU), adds the damping
+//!   `k K_d θ̇`. The feet in contact turn by `K_d θ̇` relative to the body held by the other tasks,
+//!   at most by a bound (a rigid, kinematic robot would turn its feet with nothing to damp).
+
+use kinematics::robot::SoleRectangle;
+use nalgebra::{Isometry3, Point3, Vector2};
+
+use super::config::StabilizerConfig;
+
+/// What a foot in contact should carry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct FootLoad {
+    /// Its share of the total normal force (0..=1).
+    pub share: f64,
+    /// Its centre of pressure (ground plane, m).
+    pub cop: Vector2<f64>,
+}
+
+/// Splits the desired ZMP `zmp` between the feet on the ground (`feet`: left, right sole poses,
+/// `None` in the air), each CoP kept `margin` inside its sole.
+pub(crate) fn distribute(
+    zmp: Vector2<f64>,
+    feet: [Option<&Isometry3<f64>>; 2],
+    sole: &SoleRectangle,
+    margin: f64,
+) -> [Option<FootLoad>; 2] {
+    let centre = |pose: &Isometry3<f64>| pose.translation.vector.xy();
+    match feet {
+        [Some(left), Some(right)] => {
+            let (a, b) = (centre(left), centre(right));
+            let line = b - a;
+            let t = ((zmp - a).dot(&line) / line.norm_squared()).clamp(0.0, 1.0);
+            let offset = zmp - (a + line * t);
+            [(left, 1.0 - t), (right, t)].map(|(pose, share)| {
+                Some(FootLoad {
+                    share,
+                    cop: clamp_to_sole(centre(pose) + offset, pose, sole, margin),
+                })
+            })
+        }
+        [Some(foot), None] | [None, Some(foot)] => {
+            let load = Some(FootLoad {
+                share: 1.0,
+                cop: clamp_to_sole(zmp, foot, sole, margin),
+            });
+            if feet[0].is_some() {
+                [load, None]
+            } else {
+                [None, load]
+            }
+        }
+        [None, None] => [None, None],
+    }
+}
+
+/// The foot damping's angular velocity (world x, y; rad/s) for a foot with normal force `force`
+/// (N) whose CoP is `measured` and should be `desired`, having turned by `turned` (rad) so far.
+pub(crate) fn foot_damping(
+    desired: Vector2<f64>,
+    measured: Vector2<f64>,
+    force: f64,
+    turned: Vector2<f64>,
+    config: &StabilizerConfig,
+) -> Vector2<f64> {
+    let error = desired - measured;
+    let rate = config.foot_damping_gain * force.max(0.0);
+    let omega = Vector2::new(-rate * error.y, rate * error.x) - turned / config.foot_damping_leak_s;
+    bounded(omega, config.foot_damping_max_speed)
+}
+
+/// The force-difference velocity `v` (m/s; the left foot moves by `−v/2`, the right by `+v/2`)
+/// for desired and measured normal forces (left, right; N).
+pub(crate) fn force_difference(
+    desired: [f64; 2],
+    measured: [f64; 2],
+    config: &StabilizerConfig,
+) -> f64 {
+    let error = (desired[0] - desired[1]) - (measured[0] - measured[1]);
+    let max = config.force_difference_max_speed;
+    (config.force_difference_gain * error).clamp(-max, max)
+}
+
+/// The tilt damping's ankle rotation, kept `K_d θ̇` through the velocity of the feet in contact.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct TiltDamping {
+    applied: Vector2<f64>,
+}
+
+impl TiltDamping {
+    /// Starts again with no rotation applied.
+    pub fn reset(&mut self) {
+        *self = Self::default();
+    }
+
+    /// The angular velocity (world x, y) of the feet in contact that turns them to
+    /// `gain · tilt_rate` (`gain` = `K_d`, s), at most `max` (rad), within `dt`.
+    pub fn velocity(
+        &mut self,
+        tilt_rate: Vector2<f64>,
+        gain: f64,
+        max: f64,
+        dt: f64,
+    ) -> Vector2<f64> {
+        let target = bounded(tilt_rate * gain, max);
+        let velocity = (target - self.applied) / dt;
+        self.applied = target;
+        velocity
+    }
+}
+
+/// `p` clamped into the sole rectangle at `pose`, shrunk by `margin`.
+fn clamp_to_sole(
+    p: Vector2<f64>,
+    pose: &Isometry3<f64>,
+    sole: &SoleRectangle,
+    margin: f64,
+) -> Vector2<f64> {
+    let local = pose.inverse_transform_point(&Point3::new(p.x, p.y, pose.translation.z));
+    let (hx, hy) = (
+        (sole.length / 2.0 - margin).max(0.0),
+        (sole.width / 2.0 - margin).max(0.0),
+    );
+    let clamped = Point3::new(local.x.clamp(-hx, hx), local.y.clamp(-hy, hy), 0.0);
+    (pose * clamped).coords.xy()
+}
+
+/// `v` scaled down to at most `max` in norm.
+fn bounded(v: Vector2<f64>, max: f64) -> Vector2<f64> {
+    let norm = v.norm();
+    if norm > max { v * (max / norm) } else { v }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SOLE: SoleRectangle = SoleRectangle {
+        length: 0.2,
+        width: 0.08,
+    };
+
+    fn foot(x: f64, y: f64) -> Isometry3<f64> {
+        Isometry3::translation(x, y, 0.0)
+    }
+
+    #[test]
+    fn double_support_splits_by_the_lever_rule() {
+        let (left, right) = (foot(0.0, 0.1), foot(0.2, -0.1));
+        let zmp = Vector2::new(0.05, 0.05);
+        let [Some(l), Some(r)] = distribute(zmp, [Some(&left), Some(&right)], &SOLE, 0.01) else {
+            panic!("both feet carry");
+        };
+        assert!((l.share + r.share - 1.0).abs() < 1e-12);
+        // The shares and CoPs reproduce the ZMP when nothing is clamped.
+        let resultant = l.cop * l.share + r.cop * r.share;
+        assert!((resultant - zmp).norm() < 1e-12, "{resultant:?}");
+        assert!(l.share > r.share);
+    }
+
+    #[test]
+    fn single_support_carries_all_at_the_zmp_clamped_into_the_sole() {
+        let stance = foot(0.0, -0.1);
+        let [None, Some(load)] =
+            distribute(Vector2::new(0.0, 0.0), [None, Some(&stance)], &SOLE, 0.01)
+        else {
+            panic!("the right foot carries");
+        };
+        assert_eq!(load.share, 1.0);
+        assert!(
+            (load.cop - Vector2::new(0.0, -0.07)).norm() < 1e-12,
+            "{:?}",
+            load.cop
+        );
+    }
+
+    #[test]
+    fn damping_presses_the_side_that_should_carry_more() {
+        let config = StabilizerConfig::default();
+        // Desired CoP ahead (+x) and to the left (+y) of the measured one.
+        let none = Vector2::zeros();
+        let turn = foot_damping(Vector2::new(0.01, 0.01), none, 300.0, none, &config);
+        assert!(turn.y > 0.0, "turning about +y presses the toes down");
+        assert!(turn.x < 0.0, "turning about −x presses the left edge down");
+        let fast = foot_damping(Vector2::new(1.0, 0.0), none, 1e6, none, &config);
+        assert!((fast.norm() - config.foot_damping_max_speed).abs() < 1e-12);
+        // Without a CoP error the accumulated rotation leaks away.
+        let back = foot_damping(none, none, 300.0, Vector2::new(0.01, 0.0), &config);
+        assert!((back.x + 0.01 / config.foot_damping_leak_s).abs() < 1e-12 && back.y == 0.0);
+    }
+
+    #[test]
+    fn tilt_damping_turns_the_feet_with_the_tilt_rate() {
+        let mut damping = TiltDamping::default();
+        let dt = 0.002;
+        let mut turned = Vector2::zeros();
+        for rate in [0.1, 0.3, -0.2] {
+            turned += damping.velocity(Vector2::new(rate, 0.0), 0.03, 0.02, dt) * dt;
+            // The feet have turned by K_d θ̇ in all: the ankles by its opposite.
+            assert!((turned.x - 0.03 * rate).abs() < 1e-12);
+        }
+        // Never further than the bound.
+        turned += damping.velocity(Vector2::new(10.0, 0.0), 0.03, 0.02, dt) * dt;
+        assert!((turned.x - 0.02).abs() < 1e-12);
+    }
+
+    #[test]
+    fn force_difference_lowers_the_foot_that_should_carry_more() {
+        let config = StabilizerConfig::default();
+        let v = force_difference([400.0, 200.0], [300.0, 300.0], &config);
+        assert!(v > 0.0, "the left foot (−v/2) presses down");
+        assert!(
+            force_difference([1e9, 0.0], [0.0, 0.0], &config) <= config.force_difference_max_speed
+        );
+    }
+}

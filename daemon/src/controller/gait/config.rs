@@ -1,0 +1,410 @@
+//! The `[gait]` section of a robot config: the gait a walk uses unless it asks for one, and the
+//! dynamic gait's step timing, pendulum height, touchdown bounds and stabilizer
+//! (`[gait.dynamic]`, `[gait.dynamic.stabilizer]`). Every key is optional; an unknown key is an
+//! error naming the file, the table and the key.
+
+use std::path::Path;
+
+use serde::Deserialize;
+use stance::Gait;
+
+use kinematics::ConfigFile;
+
+use crate::controller::config::ConfigError;
+
+/// What a robot config says about gaits. Without a `[gait]` section a robot walks statically
+/// only.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct GaitConfig {
+    /// The gait of a walk that does not ask for one (`[gait] default`, `static` if absent).
+    pub default: Gait,
+    /// The dynamic gait's tuning; `None` when the config has no `[gait.dynamic]`, and then a
+    /// dynamic walk is refused.
+    pub dynamic: Option<DynamicGaitConfig>,
+}
+
+/// Timing, pendulum and touchdown parameters of the dynamic gait (`[gait.dynamic]`).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DynamicGaitConfig {
+    /// Duration of a single-support phase: lift-off to planned touchdown (s).
+    pub single_support_s: f64,
+    /// Duration of a double-support phase between two steps: the ZMP crosses to the next
+    /// stance foot (s).
+    pub double_support_s: f64,
+    /// The double support before the first lift-off: the CoM starts at rest and has to reach
+    /// the sway of the first step (s).
+    pub initial_double_support_s: f64,
+    /// The double support after the last touchdown: the ZMP returns to the centre of the feet
+    /// and the CoM comes to rest (s).
+    pub final_double_support_s: f64,
+    /// A transition that changes only hand contacts: the hands reach, the feet stay (s).
+    pub hand_transition_s: f64,
+    /// Height of the CoM above the support surface, the pendulum length `h` of ω² = g / h (m);
+    /// absent: the CoM height of the standing posture.
+    pub com_height_m: Option<f64>,
+    /// The swing ends this far below its contact pose, so the sole presses into the ground and
+    /// force-torque confirms the touchdown at the planned instant (m).
+    pub landing_depth_m: f64,
+    /// A touchdown confirmed by force-torque up to this long before the planned instant is
+    /// accepted (the foot is anchored where it landed); contact readings before that are ignored
+    /// as spikes (s).
+    pub early_touchdown_s: f64,
+    /// Up to this long after the planned instant the foot keeps descending at
+    /// `late_descent_speed` and the plan waits at the touchdown instant; past it the missing
+    /// touchdown is a fault (s).
+    pub late_touchdown_max_s: f64,
+    /// Descent speed of a foot that has not touched down at the planned instant (m/s).
+    pub late_descent_speed: f64,
+    /// A foot still loaded at its planned lift-off keeps its contact, and the plan waits, up to
+    /// this long; then it lifts (s).
+    pub late_lift_off_max_s: f64,
+    /// Replaces `[controller] hand_weight` in the dynamic gait: a hand held at its contact pose
+    /// while the body walks on at speed drags the torso round and the stance foot slips about its
+    /// vertical axis; absent: the `[controller]` value.
+    pub hand_weight: Option<f64>,
+    /// The stabilizer closing the loop on force-torque and IMU.
+    #[serde(skip)]
+    pub stabilizer: StabilizerConfig,
+}
+
+impl Default for DynamicGaitConfig {
+    fn default() -> Self {
+        Self {
+            single_support_s: 0.7,
+            double_support_s: 0.1,
+            initial_double_support_s: 1.0,
+            final_double_support_s: 1.0,
+            hand_transition_s: 0.5,
+            com_height_m: None,
+            landing_depth_m: 0.001,
+            early_touchdown_s: 0.1,
+            late_touchdown_max_s: 0.2,
+            late_descent_speed: 0.05,
+            late_lift_off_max_s: 0.2,
+            hand_weight: None,
+            stabilizer: StabilizerConfig::default(),
+        }
+    }
+}
+
+/// The stabilizer's parts, each with its switch, so its effect can be measured
+/// (`[gait.dynamic.stabilizer]`).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StabilizerConfig {
+    /// The commanded ZMP is kept this far inside the support polygon (m).
+    pub zmp_margin_m: f64,
+    /// DCM feedback on the measured CoM: the commanded ZMP moves by `dcm_gain` times the DCM
+    /// error. Off, the commanded pendulum follows the reference open loop.
+    pub dcm_feedback: bool,
+    /// `K` of `p_d = p_ref + K (ξ − ξ_ref)`; above 1, the error decays at `ω (K − 1)`.
+    pub dcm_gain: f64,
+    /// The measured CoM is turned by the IMU's tilt relative to leg odometry about the measured
+    /// ZMP: a robot rolling over a sole edge shows in its DCM (leg odometry assumes the soles
+    /// flat).
+    pub imu_tilt: bool,
+    /// Time constant of the low-pass filter on the measured CoM velocity (s).
+    pub velocity_filter_s: f64,
+    /// Integrates the error between the measured and the commanded ZMP into an estimate of the
+    /// CoM model error and shifts the commanded CoM by it.
+    pub zmp_offset: bool,
+    /// Time constant of that integrator (s).
+    pub zmp_offset_time_constant_s: f64,
+    /// Bound on the estimated offset (m).
+    pub zmp_offset_max_m: f64,
+    /// Foot damping: each foot in contact turns so its measured centre of pressure tracks the
+    /// desired one (rate = gain · normal force · CoP error).
+    pub foot_damping: bool,
+    /// Foot damping gain (rad/s per N·m).
+    pub foot_damping_gain: f64,
+    /// Bound on the foot damping's angular velocity (rad/s).
+    pub foot_damping_max_speed: f64,
+    /// Time constant of the leak of the foot damping's accumulated rotation (s).
+    pub foot_damping_leak_s: f64,
+    /// Force-difference control in double support: the feet move vertically against each other
+    /// until their normal forces split as the desired ZMP asks.
+    pub force_difference: bool,
+    /// Force-difference gain (m/s per N).
+    pub force_difference_gain: f64,
+    /// Bound on the force-difference velocity (m/s).
+    pub force_difference_max_speed: f64,
+    /// Tilt damping: the ankles of the feet in contact turn against the body's tilt rate (IMU),
+    /// damping its rocking on the compliant soles.
+    pub tilt_damping: bool,
+    /// `K_d` of the ankle rotation `−K_d θ̇` (s).
+    pub tilt_damping_s: f64,
+    /// Time constant of the low-pass filter on the tilt rate (s).
+    pub tilt_rate_filter_s: f64,
+    /// Bound on the tilt damping's ankle rotation (rad).
+    pub tilt_damping_max_rad: f64,
+}
+
+impl Default for StabilizerConfig {
+    fn default() -> Self {
+        Self {
+            zmp_margin_m: 0.01,
+            dcm_feedback: true,
+            dcm_gain: 2.0,
+            imu_tilt: true,
+            velocity_filter_s: 0.01,
+            zmp_offset: true,
+            zmp_offset_time_constant_s: 1.0,
+            zmp_offset_max_m: 0.03,
+            foot_damping: true,
+            foot_damping_gain: 1e-4,
+            foot_damping_max_speed: 0.2,
+            foot_damping_leak_s: 1.0,
+            force_difference: true,
+            force_difference_gain: 1e-5,
+            force_difference_max_speed: 0.02,
+            tilt_damping: true,
+            tilt_damping_s: 0.03,
+            tilt_rate_filter_s: 0.01,
+            tilt_damping_max_rad: 0.01,
+        }
+    }
+}
+
+const GAIT: &str = "gait";
+const DYNAMIC: &str = "gait.dynamic";
+const STABILIZER: &str = "gait.dynamic.stabilizer";
+
+impl GaitConfig {
+    /// Reads the `[gait]` section of the robot config file at `path`.
+    pub fn from_config_file(path: &Path) -> Result<Self, ConfigError> {
+        Self::from_config(&ConfigFile::load(path)?)
+    }
+
+    /// Reads the `[gait]` section of a loaded robot config.
+    pub fn from_config(file: &ConfigFile) -> Result<Self, ConfigError> {
+        Self::from_section(file.section(GAIT), &file.origin())
+    }
+
+    /// The dynamic gait's tuning, or why a dynamic walk cannot be executed on this robot.
+    pub fn dynamic(&self) -> Result<&DynamicGaitConfig, String> {
+        self.dynamic.as_ref().ok_or_else(|| {
+            "the dynamic gait needs a [gait.dynamic] section in the robot config".to_owned()
+        })
+    }
+
+    fn from_section(section: Option<&toml::Value>, origin: &str) -> Result<Self, ConfigError> {
+        let Some(section) = section else {
+            return Ok(Self::default());
+        };
+        let mut section = sub_table(section, origin, GAIT)?;
+        let dynamic = section.remove("dynamic");
+        let keys: GaitSection = deserialize(section, origin, GAIT)?;
+        let mut config = Self {
+            default: keys.default,
+            dynamic: None,
+        };
+        if let Some(dynamic) = dynamic {
+            let mut dynamic = sub_table(&dynamic, origin, DYNAMIC)?;
+            let stabilizer = dynamic.remove("stabilizer");
+            let mut parsed: DynamicGaitConfig = deserialize(dynamic, origin, DYNAMIC)?;
+            if let Some(stabilizer) = stabilizer {
+                parsed.stabilizer = deserialize(
+                    sub_table(&stabilizer, origin, STABILIZER)?,
+                    origin,
+                    STABILIZER,
+                )?;
+            }
+            parsed.validate(origin)?;
+            config.dynamic = Some(parsed);
+        }
+        Ok(config)
+    }
+}
+
+/// The keys of `[gait]` itself.
+#[derive(Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+struct GaitSection {
+    default: Gait,
+}
+
+fn sub_table(
+    value: &toml::Value,
+    origin: &str,
+    section: &'static str,
+) -> Result<toml::Table, ConfigError> {
+    value
+        .as_table()
+        .cloned()
+        .ok_or_else(|| ConfigError::Section {
+            origin: origin.to_owned(),
+            section,
+            message: "must be a table".to_owned(),
+        })
+}
+
+fn deserialize<T: serde::de::DeserializeOwned>(
+    table: toml::Table,
+    origin: &str,
+    section: &'static str,
+) -> Result<T, ConfigError> {
+    toml::Value::Table(table)
+        .try_into()
+        .map_err(|e: toml::de::Error| ConfigError::Section {
+            origin: origin.to_owned(),
+            section,
+            message: e.message().to_owned(),
+        })
+}
+
+impl DynamicGaitConfig {
+    /// Checks every value is finite and in range; `origin` names the file in the error.
+    pub fn validate(&self, origin: &str) -> Result<(), ConfigError> {
+        let s = &self.stabilizer;
+        let positive = [
+            (DYNAMIC, "single_support_s", self.single_support_s),
+            (DYNAMIC, "double_support_s", self.double_support_s),
+            (
+                DYNAMIC,
+                "initial_double_support_s",
+                self.initial_double_support_s,
+            ),
+            (
+                DYNAMIC,
+                "final_double_support_s",
+                self.final_double_support_s,
+            ),
+            (DYNAMIC, "hand_transition_s", self.hand_transition_s),
+            (DYNAMIC, "com_height_m", self.com_height_m.unwrap_or(1.0)),
+            (DYNAMIC, "hand_weight", self.hand_weight.unwrap_or(1.0)),
+            (DYNAMIC, "late_descent_speed", self.late_descent_speed),
+            (STABILIZER, "dcm_gain", s.dcm_gain),
+            (STABILIZER, "velocity_filter_s", s.velocity_filter_s),
+            (
+                STABILIZER,
+                "zmp_offset_time_constant_s",
+                s.zmp_offset_time_constant_s,
+            ),
+            (STABILIZER, "tilt_rate_filter_s", s.tilt_rate_filter_s),
+            (STABILIZER, "foot_damping_leak_s", s.foot_damping_leak_s),
+        ];
+        let non_negative = [
+            (DYNAMIC, "landing_depth_m", self.landing_depth_m),
+            (DYNAMIC, "early_touchdown_s", self.early_touchdown_s),
+            (DYNAMIC, "late_touchdown_max_s", self.late_touchdown_max_s),
+            (DYNAMIC, "late_lift_off_max_s", self.late_lift_off_max_s),
+            (STABILIZER, "zmp_margin_m", s.zmp_margin_m),
+            (STABILIZER, "zmp_offset_max_m", s.zmp_offset_max_m),
+            (STABILIZER, "foot_damping_gain", s.foot_damping_gain),
+            (
+                STABILIZER,
+                "foot_damping_max_speed",
+                s.foot_damping_max_speed,
+            ),
+            (STABILIZER, "force_difference_gain", s.force_difference_gain),
+            (
+                STABILIZER,
+                "force_difference_max_speed",
+                s.force_difference_max_speed,
+            ),
+            (STABILIZER, "tilt_damping_s", s.tilt_damping_s),
+            (STABILIZER, "tilt_damping_max_rad", s.tilt_damping_max_rad),
+        ];
+        let fail = |section, key, value, requirement| ConfigError::Value {
+            origin: origin.to_owned(),
+            section,
+            key,
+            value,
+            requirement,
+        };
+        for (section, key, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(fail(section, key, value, "must be finite and > 0"));
+            }
+        }
+        for (section, key, value) in non_negative {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(fail(section, key, value, "must be finite and >= 0"));
+            }
+        }
+        if self.early_touchdown_s >= self.single_support_s {
+            return Err(fail(
+                DYNAMIC,
+                "early_touchdown_s",
+                self.early_touchdown_s,
+                "must be shorter than single_support_s",
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<GaitConfig, ConfigError> {
+        GaitConfig::from_config(&ConfigFile::parse(text, Path::new("robot.toml")).unwrap())
+    }
+
+    #[test]
+    fn without_a_gait_section_the_robot_walks_statically_only() {
+        let config = parse("[controller]\n").unwrap();
+        assert_eq!(config.default, Gait::Static);
+        let reason = config.dynamic().unwrap_err();
+        assert!(reason.contains("[gait.dynamic]"), "{reason}");
+    }
+
+    #[test]
+    fn partial_tables_keep_the_defaults() {
+        let config = parse(
+            "[gait]\ndefault = \"dynamic\"\n[gait.dynamic]\nsingle_support_s = 0.6\n\
+             [gait.dynamic.stabilizer]\nfoot_damping = false\n",
+        )
+        .unwrap();
+        assert_eq!(config.default, Gait::Dynamic);
+        let dynamic = config.dynamic().unwrap();
+        assert_eq!(dynamic.single_support_s, 0.6);
+        assert_eq!(
+            dynamic.double_support_s,
+            DynamicGaitConfig::default().double_support_s
+        );
+        assert!(!dynamic.stabilizer.foot_damping);
+        assert!(dynamic.stabilizer.dcm_feedback);
+    }
+
+    #[test]
+    fn unknown_keys_name_their_table() {
+        for (text, table, key) in [
+            ("[gait]\ndefualt = \"static\"\n", "[gait]", "defualt"),
+            (
+                "[gait.dynamic]\nsingle_support = 0.6\n",
+                "[gait.dynamic]",
+                "single_support",
+            ),
+            (
+                "[gait.dynamic.stabilizer]\ndcm_gian = 2.0\n",
+                "[gait.dynamic.stabilizer]",
+                "dcm_gian",
+            ),
+        ] {
+            let error = parse(text).unwrap_err().to_string();
+            assert!(error.contains(table) && error.contains(key), "{error}");
+        }
+        let error = parse("[gait]\ndefault = \"fast\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("fast"), "{error}");
+    }
+
+    #[test]
+    fn bad_values_are_named() {
+        let error = parse("[gait.dynamic]\ndouble_support_s = 0.0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("double_support_s"), "{error}");
+        let error = parse("[gait.dynamic.stabilizer]\ndcm_gain = -1.0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("[gait.dynamic.stabilizer] dcm_gain"),
+            "{error}"
+        );
+    }
+}

@@ -1,0 +1,389 @@
+//! The footstep plan: a sequence's foot-contact changes as timed support phases.
+//!
+//! Walking the stances in order from both feet standing, every change of the feet in contact
+//! becomes phases of the configured durations:
+//! - a foot released (double → single support): a double-support phase (the ZMP crosses to the
+//!   foot that stays), at whose end the foot lifts off; the first one lasts
+//!   `initial_double_support_s`, so the CoM can start from rest;
+//! - a foot added (single → double support): the single-support phase in which it swings, from
+//!   lift-off through the highest post-processed swing pose of its flight to its contact pose;
+//! - a foot added and the other released at once (single support on one foot, then on the
+//!   other): that swing, then a double support before the lift-off;
+//! - only hands change: a double support of `hand_transition_s` while they reach;
+//! - nothing changes (repeated stances, or a swing passing another swing pose): no phase.
+//!
+//! The walk ends with `final_double_support_s` of double support after the last touchdown; a
+//! sequence ending with a foot in the air is refused. The phases of each stance form a
+//! [`Transition`]: its posture is the reference and its hands reach within it.
+
+use std::ops::Range;
+
+use kinematics::robot::EndEffector;
+use nalgebra::Isometry3;
+
+use super::config::DynamicGaitConfig;
+use crate::controller::sequence::{PreparedStance, Refusal};
+
+/// The feet, in the order of the `[_; 2]` arrays of this module (left, right).
+pub(crate) const FEET: [EndEffector; 2] = [EndEffector::LeftFoot, EndEffector::RightFoot];
+
+/// A swing as planned (sequence frame): the pose it passes at mid-swing and where it lands.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SwingPlan {
+    /// The swinging foot.
+    pub foot: EndEffector,
+    /// The post-processed swing pose: its height is the apex, its orientation the foot's there.
+    pub apex: Isometry3<f64>,
+    /// The contact pose of the stance it lands in.
+    pub landing: Isometry3<f64>,
+}
+
+/// Which feet carry the robot during a phase.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Support {
+    /// Both feet on the ground; `lift_off` leaves it at the phase's end.
+    Double { lift_off: Option<EndEffector> },
+    /// One foot on the ground while the other swings to its landing, at the phase's end.
+    Single(SwingPlan),
+}
+
+/// One timed phase of the plan.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SupportPhase {
+    /// What carries the robot.
+    pub support: Support,
+    /// Start on the plan clock (s).
+    pub start_s: f64,
+    /// Duration (s).
+    pub duration_s: f64,
+    /// Planned sole poses of the feet on the ground (left, right; `None` in the air).
+    pub feet: [Option<Isometry3<f64>>; 2],
+}
+
+impl SupportPhase {
+    /// End on the plan clock (s).
+    pub fn end_s(&self) -> f64 {
+        self.start_s + self.duration_s
+    }
+}
+
+/// The phases that lead to one stance: within them its hands reach, and its posture is the
+/// posture reference.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Transition {
+    /// Index of the stance.
+    pub stance: usize,
+    /// Its phases, indices into [`FootstepPlan::phases`].
+    pub phases: Range<usize>,
+}
+
+/// The timed phases of a sequence and their grouping by stance.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct FootstepPlan {
+    /// Back to back from the plan clock's zero.
+    pub phases: Vec<SupportPhase>,
+    /// In stance order; stances without any change have none.
+    pub transitions: Vec<Transition>,
+}
+
+/// Builds the plan while walking the stances.
+struct Builder<'a> {
+    timing: &'a DynamicGaitConfig,
+    plan: FootstepPlan,
+    clock: f64,
+    /// Planned poses of the feet on the ground.
+    feet: [Option<Isometry3<f64>>; 2],
+    /// The swing under way: its foot and the highest swing pose so far.
+    swing: Option<(EndEffector, Isometry3<f64>)>,
+    stepped: bool,
+}
+
+impl FootstepPlan {
+    /// The plan of `stances` for a robot standing on both feet at `standing` (left, right sole
+    /// poses in the sequence's frame).
+    pub fn new(
+        stances: &[PreparedStance],
+        standing: [Isometry3<f64>; 2],
+        timing: &DynamicGaitConfig,
+    ) -> Result<Self, Refusal> {
+        let mut builder = Builder {
+            timing,
+            plan: FootstepPlan {
+                phases: Vec::with_capacity(2 * stances.len() + 1),
+                transitions: Vec::with_capacity(stances.len()),
+            },
+            clock: 0.0,
+            feet: standing.map(Some),
+            swing: None,
+            stepped: false,
+        };
+        let mut hands = [false; 2];
+        for (i, stance) in stances.iter().enumerate() {
+            let first_phase = builder.plan.phases.len();
+            let next_hands = [
+                stance.contacts[EndEffector::LeftHand as usize],
+                stance.contacts[EndEffector::RightHand as usize],
+            ];
+            builder.stance(stance, next_hands != hands);
+            hands = next_hands;
+            let phases = first_phase..builder.plan.phases.len();
+            if !phases.is_empty() {
+                builder
+                    .plan
+                    .transitions
+                    .push(Transition { stance: i, phases });
+            }
+        }
+        if builder.swing.is_some() {
+            return Err(Refusal(format!(
+                "stance {}: the dynamic gait comes to rest on both feet, but the sequence ends \
+                 with a foot in the air",
+                stances.len() - 1
+            )));
+        }
+        let last = builder.plan.phases.len();
+        builder.double_support(timing.final_double_support_s, None);
+        match builder.plan.transitions.last_mut() {
+            Some(transition) if transition.stance == stances.len() - 1 => {
+                transition.phases.end = last + 1;
+            }
+            _ => builder.plan.transitions.push(Transition {
+                stance: stances.len() - 1,
+                phases: last..last + 1,
+            }),
+        }
+        Ok(builder.plan)
+    }
+
+    /// Planned duration of the whole walk (s).
+    #[cfg(test)]
+    pub fn duration_s(&self) -> f64 {
+        self.phases.last().map_or(0.0, SupportPhase::end_s)
+    }
+}
+
+impl Builder<'_> {
+    /// Adds the phases that lead from the current support to `stance`'s.
+    fn stance(&mut self, stance: &PreparedStance, hands_change: bool) {
+        let in_contact = FEET.map(|f| stance.contacts[f as usize]);
+        let added = [0, 1].map(|f| in_contact[f] && self.feet[f].is_none());
+        let released = [0, 1].map(|f| !in_contact[f] && self.feet[f].is_some());
+        if let Some((foot, apex)) = &mut self.swing {
+            let candidate = stance.targets[*foot as usize];
+            if !in_contact[slot(*foot)] && candidate.translation.z > apex.translation.z {
+                *apex = candidate;
+            }
+        }
+        for f in 0..2 {
+            if added[f] {
+                self.touchdown(FEET[f], stance.targets[FEET[f] as usize]);
+            }
+        }
+        for f in 0..2 {
+            if released[f] {
+                let duration = if self.stepped {
+                    self.timing.double_support_s
+                } else {
+                    self.timing.initial_double_support_s
+                };
+                self.double_support(duration, Some(FEET[f]));
+                self.feet[f] = None;
+                self.swing = Some((FEET[f], stance.targets[FEET[f] as usize]));
+            }
+        }
+        let feet_change = added.iter().chain(&released).any(|c| *c);
+        if hands_change && !feet_change && self.swing.is_none() {
+            self.double_support(self.timing.hand_transition_s, None);
+        }
+    }
+
+    /// The single support in which the swing under way lands `foot` at `landing`.
+    fn touchdown(&mut self, foot: EndEffector, landing: Isometry3<f64>) {
+        let (swinging, apex) = self
+            .swing
+            .take()
+            .expect("a foot is added only while it is in the air");
+        debug_assert_eq!(swinging, foot);
+        self.push(
+            Support::Single(SwingPlan {
+                foot,
+                apex,
+                landing,
+            }),
+            self.timing.single_support_s,
+        );
+        self.feet[slot(foot)] = Some(landing);
+        self.stepped = true;
+    }
+
+    fn double_support(&mut self, duration: f64, lift_off: Option<EndEffector>) {
+        self.push(Support::Double { lift_off }, duration);
+    }
+
+    fn push(&mut self, support: Support, duration_s: f64) {
+        self.plan.phases.push(SupportPhase {
+            support,
+            start_s: self.clock,
+            duration_s,
+            feet: self.feet,
+        });
+        self.clock += duration_s;
+    }
+}
+
+/// Index of a foot in the `[_; 2]` arrays.
+fn slot(foot: EndEffector) -> usize {
+    match foot {
+        EndEffector::LeftFoot => 0,
+        EndEffector::RightFoot => 1,
+        hand => unreachable!("{hand:?} is not a foot"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{DVector, Translation3};
+
+    use super::*;
+
+    const LF: usize = EndEffector::LeftFoot as usize;
+    const RF: usize = EndEffector::RightFoot as usize;
+    const LH: usize = EndEffector::LeftHand as usize;
+
+    fn at(x: f64, y: f64, z: f64) -> Isometry3<f64> {
+        Isometry3::from_parts(Translation3::new(x, y, z), Default::default())
+    }
+
+    fn stance(contacts: [bool; 4], left: Isometry3<f64>, right: Isometry3<f64>) -> PreparedStance {
+        let mut targets = [Isometry3::identity(); 4];
+        targets[LF] = left;
+        targets[RF] = right;
+        PreparedStance {
+            posture: DVector::zeros(1),
+            contacts,
+            targets,
+        }
+    }
+
+    const DS: [bool; 4] = [true, true, false, false];
+    const LEFT_UP: [bool; 4] = [false, true, false, false];
+    const RIGHT_UP: [bool; 4] = [true, false, false, false];
+
+    fn standing() -> [Isometry3<f64>; 2] {
+        [at(0.0, 0.1, 0.0), at(0.0, -0.1, 0.0)]
+    }
+
+    fn kinds(plan: &FootstepPlan) -> Vec<&'static str> {
+        plan.phases
+            .iter()
+            .map(|p| match p.support {
+                Support::Double { lift_off: None } => "ds",
+                Support::Double { lift_off: Some(_) } => "ds+lift",
+                Support::Single(_) => "ss",
+            })
+            .collect()
+    }
+
+    #[test]
+    fn alternating_stances_become_timed_steps() {
+        let timing = DynamicGaitConfig::default();
+        let stances = [
+            stance(DS, standing()[0], standing()[1]),
+            stance(LEFT_UP, at(0.1, 0.1, 0.05), standing()[1]),
+            stance(DS, at(0.2, 0.1, 0.0), standing()[1]),
+            stance(RIGHT_UP, at(0.2, 0.1, 0.0), at(0.2, -0.1, 0.06)),
+            stance(DS, at(0.2, 0.1, 0.0), at(0.4, -0.1, 0.0)),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        assert_eq!(kinds(&plan), ["ds+lift", "ss", "ds+lift", "ss", "ds"]);
+        let durations: Vec<f64> = plan.phases.iter().map(|p| p.duration_s).collect();
+        assert_eq!(
+            durations,
+            [
+                timing.initial_double_support_s,
+                timing.single_support_s,
+                timing.double_support_s,
+                timing.single_support_s,
+                timing.final_double_support_s
+            ]
+        );
+        for pair in plan.phases.windows(2) {
+            assert!((pair[0].end_s() - pair[1].start_s).abs() < 1e-12);
+        }
+        let Support::Single(swing) = plan.phases[1].support else {
+            panic!("phase 1 swings");
+        };
+        assert_eq!(swing.foot, EndEffector::LeftFoot);
+        assert_eq!(swing.apex, at(0.1, 0.1, 0.05));
+        assert_eq!(swing.landing, at(0.2, 0.1, 0.0));
+        assert_eq!(plan.phases[1].feet, [None, Some(standing()[1])]);
+        assert_eq!(
+            plan.phases[4].feet,
+            [Some(at(0.2, 0.1, 0.0)), Some(at(0.4, -0.1, 0.0))]
+        );
+        let stances_of: Vec<usize> = plan.transitions.iter().map(|t| t.stance).collect();
+        assert_eq!(stances_of, [1, 2, 3, 4]);
+        assert_eq!(plan.transitions[3].phases, 3..5);
+    }
+
+    #[test]
+    fn single_support_on_one_foot_then_the_other_gets_a_double_support_between() {
+        let timing = DynamicGaitConfig::default();
+        let stances = [
+            stance(RIGHT_UP, standing()[0], at(0.1, -0.1, 0.05)),
+            stance(LEFT_UP, at(0.0, 0.1, 0.05), at(0.2, -0.1, 0.0)),
+            stance(DS, at(0.3, 0.1, 0.0), at(0.2, -0.1, 0.0)),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        assert_eq!(kinds(&plan), ["ds+lift", "ss", "ds+lift", "ss", "ds"]);
+        assert_eq!(plan.transitions[1].stance, 1);
+        assert_eq!(plan.transitions[1].phases, 1..3);
+    }
+
+    #[test]
+    fn repeated_stances_add_nothing_and_a_swing_takes_its_highest_pose() {
+        let timing = DynamicGaitConfig::default();
+        let stances = [
+            stance(DS, standing()[0], standing()[1]),
+            stance(DS, standing()[0], standing()[1]),
+            stance(LEFT_UP, at(0.05, 0.1, 0.04), standing()[1]),
+            stance(LEFT_UP, at(0.1, 0.1, 0.07), standing()[1]),
+            stance(DS, at(0.2, 0.1, 0.0), standing()[1]),
+            stance(DS, at(0.2, 0.1, 0.0), standing()[1]),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        assert_eq!(kinds(&plan), ["ds+lift", "ss", "ds"]);
+        let Support::Single(swing) = plan.phases[1].support else {
+            panic!("phase 1 swings");
+        };
+        assert_eq!(swing.apex, at(0.1, 0.1, 0.07));
+        let stances_of: Vec<usize> = plan.transitions.iter().map(|t| t.stance).collect();
+        assert_eq!(stances_of, [2, 4, 5]);
+    }
+
+    #[test]
+    fn hand_only_changes_get_a_reach_phase() {
+        let timing = DynamicGaitConfig::default();
+        let mut with_hand = DS;
+        with_hand[LH] = true;
+        let stances = [
+            stance(with_hand, standing()[0], standing()[1]),
+            stance(DS, standing()[0], standing()[1]),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        assert_eq!(kinds(&plan), ["ds", "ds", "ds"]);
+        assert_eq!(plan.phases[0].duration_s, timing.hand_transition_s);
+        assert_eq!(plan.transitions[1].phases, 1..3);
+    }
+
+    #[test]
+    fn a_sequence_ending_in_the_air_is_refused() {
+        let stances = [
+            stance(DS, standing()[0], standing()[1]),
+            stance(LEFT_UP, at(0.1, 0.1, 0.05), standing()[1]),
+        ];
+        let refusal =
+            FootstepPlan::new(&stances, standing(), &DynamicGaitConfig::default()).unwrap_err();
+        assert!(refusal.0.contains("stance 1"), "{refusal}");
+    }
+}

@@ -1,0 +1,146 @@
+//! The swing foot's trajectory, timed with its single-support phase.
+//!
+//! Horizontally (x, y) one minimum-jerk motion from the lift-off to the landing position over
+//! the whole swing; vertically and in orientation two minimum-jerk halves, up to the apex (the
+//! post-processed swing pose's height and orientation) at mid-swing and down to the landing.
+//! Minimum-jerk pieces start and end with zero velocity and acceleration, so the foot leaves the
+//! ground and lands at rest, and the halves join smoothly at the apex (vertical velocity and
+//! acceleration zero there).
+
+use nalgebra::{Isometry3, Translation3, Vector2};
+
+use crate::controller::trajectory::{PointTrajectory, PoseTrajectory, Profile};
+
+/// A swing from lift-off to landing.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SwingTrajectory {
+    horizontal: PointTrajectory,
+    rise: PoseTrajectory,
+    descent: PoseTrajectory,
+    duration: f64,
+}
+
+impl SwingTrajectory {
+    /// A swing lasting `duration` (s, > 0) from `lift_off` through the height and orientation
+    /// of `apex` to `landing`.
+    pub fn new(
+        lift_off: Isometry3<f64>,
+        apex: Isometry3<f64>,
+        landing: Isometry3<f64>,
+        duration: f64,
+    ) -> Self {
+        let start = lift_off.translation.vector.xy();
+        let goal = landing.translation.vector.xy();
+        let middle = (start + goal) / 2.0;
+        let top = Isometry3::from_parts(
+            Translation3::new(middle.x, middle.y, apex.translation.z),
+            apex.rotation,
+        );
+        let half = duration / 2.0;
+        Self {
+            horizontal: PointTrajectory::new(start, goal, duration),
+            rise: PoseTrajectory::new(lift_off, top, half, Profile::MinimumJerk),
+            descent: PoseTrajectory::new(top, landing, half, Profile::MinimumJerk),
+            duration,
+        }
+    }
+
+    /// The landing pose.
+    pub fn landing(&self) -> &Isometry3<f64> {
+        self.descent.goal()
+    }
+
+    /// Pose and world velocity (linear xyz, angular xyz) at time `t` after lift-off; after the
+    /// swing, the landing pose at rest.
+    pub fn sample(&self, t: f64) -> (Isometry3<f64>, [f64; 6]) {
+        let half = self.duration / 2.0;
+        let (xy, xy_velocity): (Vector2<f64>, Vector2<f64>) = self.horizontal.sample(t);
+        let (mut pose, mut velocity) = if t < half {
+            self.rise.sample(t)
+        } else {
+            self.descent.sample(t - half)
+        };
+        pose.translation.x = xy.x;
+        pose.translation.y = xy.y;
+        velocity[0] = xy_velocity.x;
+        velocity[1] = xy_velocity.y;
+        (pose, velocity)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::UnitQuaternion;
+
+    use super::*;
+
+    fn swing() -> (
+        SwingTrajectory,
+        Isometry3<f64>,
+        Isometry3<f64>,
+        Isometry3<f64>,
+    ) {
+        let lift_off = Isometry3::translation(0.0, 0.1, 0.0);
+        let apex = Isometry3::from_parts(
+            Translation3::new(0.12, 0.07, 0.06),
+            UnitQuaternion::from_euler_angles(0.0, 0.15, 0.05),
+        );
+        let landing = Isometry3::from_parts(
+            Translation3::new(0.2, 0.1, -0.003),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, 0.1),
+        );
+        (
+            SwingTrajectory::new(lift_off, apex, landing, 0.6),
+            lift_off,
+            apex,
+            landing,
+        )
+    }
+
+    #[test]
+    fn the_swing_leaves_and_lands_at_rest() {
+        let (swing, lift_off, _, landing) = swing();
+        let (start, v0) = swing.sample(0.0);
+        let (end, v1) = swing.sample(0.6);
+        assert!((start.translation.vector - lift_off.translation.vector).norm() < 1e-12);
+        assert!((end.translation.vector - landing.translation.vector).norm() < 1e-12);
+        assert!(end.rotation.angle_to(&landing.rotation) < 1e-12);
+        assert!(
+            v0.iter().chain(&v1).all(|v| v.abs() < 1e-12),
+            "{v0:?} {v1:?}"
+        );
+        // Just before landing the foot is nearly still (minimum jerk: velocity ~ τ²).
+        let (_, late) = swing.sample(0.6 - 1e-3);
+        assert!(late.iter().all(|v| v.abs() < 1e-3), "{late:?}");
+    }
+
+    #[test]
+    fn the_apex_is_reached_at_mid_swing_and_is_the_highest_point() {
+        let (swing, _, apex, _) = swing();
+        let (top, velocity) = swing.sample(0.3);
+        assert!((top.translation.z - apex.translation.z).abs() < 1e-12);
+        assert!(top.rotation.angle_to(&apex.rotation) < 1e-12);
+        assert!(velocity[2].abs() < 1e-12, "vertical velocity at the apex");
+        for k in 0..=60 {
+            let (pose, _) = swing.sample(f64::from(k) * 0.01);
+            assert!(pose.translation.z <= apex.translation.z + 1e-12);
+        }
+    }
+
+    #[test]
+    fn the_velocity_is_the_derivative_of_the_pose() {
+        let (swing, ..) = swing();
+        let h = 1e-6;
+        for t in [0.1, 0.25, 0.31, 0.45] {
+            let (a, _) = swing.sample(t - h);
+            let (b, _) = swing.sample(t + h);
+            let (_, v) = swing.sample(t);
+            let linear = (b.translation.vector - a.translation.vector) / (2.0 * h);
+            let angular = (b.rotation * a.rotation.inverse()).scaled_axis() / (2.0 * h);
+            for k in 0..3 {
+                assert!((linear[k] - v[k]).abs() < 1e-6, "t {t} linear {k}");
+                assert!((angular[k] - v[3 + k]).abs() < 1e-6, "t {t} angular {k}");
+            }
+        }
+    }
+}

@@ -1,0 +1,622 @@
+//! The dynamic gait's state machine: runs a [`DynamicPlan`] on its plan clock and produces the
+//! QP's set-points and contact set every tick.
+//!
+//! Phases advance on time (the ZMP reference leaves a foot before it lifts off and reaches it
+//! before it must carry the robot).
+//! A double support ends with the lift-off of its foot, once force-torque shows the weight off
+//! it (below `release_force_fraction` of the weight): while it still carries load the plan clock
+//! waits at the lift-off instant, up to `late_lift_off_max_s`, then the foot lifts anyway (a
+//! landing foot that bounced, a robot leaning back on the old stance foot). A single support
+//! ends with the touchdown, confirmed by force-torque (debounced):
+//! - early, within `early_touchdown_s` of the planned instant: the foot is anchored where it
+//!   landed and the plan runs on (the ZMP stays on the stance foot until the double support);
+//! - late: at the planned instant the plan clock stops, the foot keeps descending at
+//!   `late_descent_speed`, and the stabilizer's pendulum moves on under a ZMP clamped into the
+//!   stance foot; once force-torque confirms the contact the clock runs again. A touchdown still
+//!   missing `late_touchdown_max_s` after the planned instant is a fault.
+//!
+//! Hands change with the stance their phases lead to: a released hand leaves the contact set when
+//! its transition begins (carried along with the pelvis with `carry_released_hands`); an added
+//! hand reaches its contact pose with a minimum-jerk motion timed over the transition and is in
+//! contact at its end. After the last phase the walk settles: done once the CoM and the commanded
+//! DCM are within `com_tolerance_m` of the final feet's centre.
+
+use kinematics::ground::sequence_alignment;
+use kinematics::ground::{SupportPolygon, sole_corners};
+use kinematics::robot::{EndEffector, SoleRectangle};
+use nalgebra::{DVector, Isometry3, UnitQuaternion, Vector2, Vector3};
+
+use super::DynamicPlan;
+use super::compliance::{TiltDamping, distribute, foot_damping, force_difference};
+use super::footsteps::{FEET, Support, SupportPhase};
+use super::sensing::{DcmEstimator, TiltRate, pressure_centre, tilted_com};
+use super::stabilizer::{Measured, Stabilizer};
+use super::swing::SwingTrajectory;
+use crate::controller::config::ControllerConfig;
+use crate::controller::machine::{Balance, Feedback, PoseTarget, Progress, Targets, heading_frame};
+use crate::controller::sequence::PreparedSequence;
+use crate::controller::sequencer::on_both_feet;
+use crate::controller::status::{BalanceStatus, FaultCode, Phase};
+use crate::controller::trajectory::{PoseTrajectory, Profile};
+
+const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
+
+/// What the dynamic gait reads besides the static machine's [`Feedback`] (estimated, world).
+pub(crate) struct Sensors<'a> {
+    /// Ankle wrenches by `EndEffector` (see `Measurement::wrenches`).
+    pub wrenches: &'a [[f64; 6]; 4],
+    /// FT frame origins (left, right foot).
+    pub ft_origins: [Vector3<f64>; 2],
+    /// The leg-odometry base orientation.
+    pub base_rotation: UnitQuaternion<f64>,
+    /// The IMU's base orientation, if there is an IMU.
+    pub imu: Option<UnitQuaternion<f64>>,
+}
+
+/// The swing under way.
+#[derive(Clone, Copy, Debug)]
+struct Swing {
+    foot: EndEffector,
+    trajectory: SwingTrajectory,
+    /// Plan time of the lift-off (s).
+    lift_off_s: f64,
+}
+
+/// Execution state of a dynamic walk.
+pub(crate) struct DynamicWalker {
+    config: ControllerConfig,
+    sole: SoleRectangle,
+    touchdown_force: f64,
+    release_force: f64,
+    sequence: Option<Box<PreparedSequence>>,
+    running: bool,
+    started: bool,
+    to_world: Isometry3<f64>,
+    /// Plan time (s): stops while a late touchdown is awaited.
+    clock: f64,
+    phase: usize,
+    transition: usize,
+    /// Time waited past a planned touchdown (s).
+    late_s: Option<f64>,
+    settle_s: f64,
+    debounce: u32,
+    cursor: usize,
+    swing: Option<Swing>,
+    reaches: [Option<(PoseTrajectory, f64)>; 2],
+    /// Released hands carried with the pelvis: their pose in its planar frame.
+    carried: [Option<Isometry3<f64>>; 2],
+    stabilizer: Stabilizer,
+    estimator: DcmEstimator,
+    tilt_rate: TiltRate,
+    tilt_damping: TiltDamping,
+    /// The foot damping's rotation of each foot since it landed (world x, y; rad).
+    foot_turn: [Vector2<f64>; 2],
+    support: SupportPolygon,
+    targets: Targets,
+    balance: BalanceStatus,
+}
+
+impl DynamicWalker {
+    /// A walker for a robot of weight `weight_n` (N) with soles `sole`.
+    pub fn new(
+        config: &ControllerConfig,
+        sole: SoleRectangle,
+        weight_n: f64,
+        targets: Targets,
+    ) -> Self {
+        Self {
+            config: *config,
+            sole,
+            touchdown_force: config.touchdown_force_fraction * weight_n,
+            release_force: config.release_force_fraction * weight_n,
+            sequence: None,
+            running: false,
+            started: false,
+            to_world: Isometry3::identity(),
+            clock: 0.0,
+            phase: 0,
+            transition: 0,
+            late_s: None,
+            settle_s: 0.0,
+            debounce: 0,
+            cursor: 0,
+            swing: None,
+            reaches: [None; 2],
+            carried: [None; 2],
+            stabilizer: Stabilizer::new(Default::default(), 1.0),
+            estimator: DcmEstimator::default(),
+            tilt_rate: TiltRate::default(),
+            tilt_damping: TiltDamping::default(),
+            foot_turn: [Vector2::zeros(); 2],
+            support: SupportPolygon::empty(),
+            targets,
+            balance: BalanceStatus::default(),
+        }
+    }
+
+    /// Whether a dynamic walk is executing.
+    pub fn running(&self) -> bool {
+        self.running
+    }
+
+    /// Installs a dynamic sequence to execute from the next update; returns the previous one.
+    pub fn load(&mut self, sequence: Box<PreparedSequence>) -> Option<Box<PreparedSequence>> {
+        debug_assert!(sequence.dynamic.is_some());
+        self.running = true;
+        self.started = false;
+        self.sequence.replace(sequence)
+    }
+
+    /// Whether the walk has begun (its contact set is the live one).
+    pub fn started(&self) -> bool {
+        self.started
+    }
+
+    /// Takes over the live contact set and anchors to start the walk from.
+    pub fn take_over(&mut self, live: &Targets) {
+        self.targets = *live;
+        self.targets.unloading = None;
+        self.targets.end_effectors = [None; 4];
+        self.targets.contact_velocity = [[0.0; 6]; 2];
+        self.carried = [None; 2];
+    }
+
+    /// Stops executing (the contact set and anchors stay as they are).
+    pub fn stop(&mut self) {
+        self.running = false;
+        self.started = false;
+    }
+
+    /// The contact set, anchors and set-points of the last update.
+    pub fn targets(&self) -> &Targets {
+        &self.targets
+    }
+
+    /// The balance readings of the last update.
+    pub fn balance(&self) -> &BalanceStatus {
+        &self.balance
+    }
+
+    /// The posture reference: the stance the current phases lead to.
+    pub fn posture(&self) -> Option<&DVector<f64>> {
+        let sequence = self.sequence.as_ref()?;
+        Some(&sequence.stances[self.stance_index()].posture)
+    }
+
+    /// `config` with the dynamic gait's QP overrides.
+    pub fn qp_config(&self, config: &ControllerConfig) -> ControllerConfig {
+        let dynamic = &self.plan().config;
+        ControllerConfig {
+            hand_weight: dynamic.hand_weight.unwrap_or(config.hand_weight),
+            ..*config
+        }
+    }
+
+    /// The current phase.
+    pub fn phase(&self) -> Phase {
+        if !self.started {
+            return Phase::None;
+        }
+        match self.current_phase().map(|p| p.support) {
+            None => Phase::Settle,
+            Some(Support::Double { .. }) if self.late_s.is_some() => Phase::LateLiftOff,
+            Some(Support::Double { .. }) => Phase::DoubleSupport,
+            Some(Support::Single(_)) if self.late_s.is_some() => Phase::LateTouchdown,
+            Some(Support::Single(_)) => Phase::SingleSupport,
+        }
+    }
+
+    /// Index of the stance being moved towards and the stance count.
+    pub fn progress(&self) -> (usize, usize) {
+        (
+            self.stance_index(),
+            self.sequence.as_ref().map_or(0, |s| s.len()),
+        )
+    }
+
+    /// One tick: starts the walk on the first call after `load`, advances the plan clock and its
+    /// phases, runs the stabilizer and refreshes the targets.
+    pub fn update(&mut self, feedback: &Feedback, sensors: &Sensors, dt: f64) -> Progress {
+        if !self.started {
+            if !on_both_feet(&self.targets) {
+                self.running = false;
+                return Progress::Fault(FaultCode::NotOnBothFeet);
+            }
+            self.begin(feedback);
+        } else if let Some(late) = &mut self.late_s {
+            *late += dt;
+        } else {
+            self.clock += dt;
+        }
+        let progress = self.advance(feedback);
+        if progress != Progress::Running {
+            self.running = false;
+            self.started = false;
+        }
+        self.stabilize(feedback, sensors, dt);
+        self.refresh_targets(&feedback.pelvis);
+        progress
+    }
+
+    fn plan(&self) -> &DynamicPlan {
+        self.sequence
+            .as_ref()
+            .and_then(|s| s.dynamic.as_deref())
+            .expect("the walker runs only dynamic sequences")
+    }
+
+    fn current_phase(&self) -> Option<SupportPhase> {
+        self.plan().footsteps.phases.get(self.phase).copied()
+    }
+
+    fn stance_index(&self) -> usize {
+        let Some(sequence) = self.sequence.as_ref() else {
+            return 0;
+        };
+        let transitions = &self.plan().footsteps.transitions;
+        transitions
+            .get(self.transition)
+            .or(transitions.last())
+            .map_or(sequence.len() - 1, |t| t.stance)
+    }
+
+    /// Aligns the plan with the robot's feet, starts the pendulum at rest on the CoM.
+    fn begin(&mut self, feedback: &Feedback) {
+        let sequence = self.sequence.as_mut().expect("loaded");
+        let first = &sequence.stances[0];
+        let feet = |flags: &[bool; 4]| FEET.map(|f| flags[f as usize]);
+        let poses = |all: &[Isometry3<f64>; 4]| FEET.map(|f| all[f as usize]);
+        self.to_world = sequence_alignment(
+            &poses(&first.targets),
+            feet(&first.contacts),
+            &poses(&self.targets.anchors),
+            feet(&self.targets.contacts),
+        );
+        let plan = sequence.dynamic.as_mut().expect("a dynamic sequence");
+        plan.pattern.transform(&self.to_world);
+        let com = feedback.com.xy();
+        plan.pattern.start_at_rest(com);
+        let (stabilizer, omega) = (plan.config.stabilizer, plan.pattern.omega());
+        self.stabilizer.reset(stabilizer, omega, com);
+        self.estimator.reset();
+        self.tilt_rate.reset();
+        self.tilt_damping.reset();
+        self.foot_turn = [Vector2::zeros(); 2];
+        self.started = true;
+        self.clock = 0.0;
+        self.phase = 0;
+        self.transition = 0;
+        self.late_s = None;
+        self.settle_s = 0.0;
+        self.debounce = 0;
+        self.cursor = 0;
+        self.swing = None;
+        self.reaches = [None; 2];
+        self.begin_transition(feedback);
+    }
+
+    /// Moves through the phases the plan clock has passed.
+    fn advance(&mut self, feedback: &Feedback) -> Progress {
+        loop {
+            let Some(phase) = self.current_phase() else {
+                return self.settle(feedback);
+            };
+            match phase.support {
+                Support::Single(swing) => {
+                    let i = swing.foot as usize;
+                    if !self.targets.contacts[i] && self.touchdown_confirmed(feedback, &phase, i) {
+                        self.land(swing.foot, feedback);
+                    }
+                    if self.clock < phase.end_s() {
+                        return Progress::Running;
+                    }
+                    if !self.targets.contacts[i] {
+                        self.clock = phase.end_s();
+                        let late = self.late_s.get_or_insert(0.0);
+                        return if *late > self.plan().config.late_touchdown_max_s {
+                            Progress::Fault(FaultCode::MissedTouchdown)
+                        } else {
+                            Progress::Running
+                        };
+                    }
+                }
+                Support::Double { lift_off } => {
+                    if self.clock < phase.end_s() {
+                        return Progress::Running;
+                    }
+                    if let Some(foot) = lift_off {
+                        let loaded = feedback.normal_forces[foot as usize] > self.release_force;
+                        if loaded {
+                            self.clock = phase.end_s();
+                            let late = self.late_s.get_or_insert(0.0);
+                            if *late <= self.plan().config.late_lift_off_max_s {
+                                return Progress::Running;
+                            }
+                        }
+                        self.lift_off(foot, feedback);
+                    }
+                }
+            }
+            self.next_phase(feedback);
+        }
+    }
+
+    /// Force-torque confirms the swing foot's contact (debounced), and the planned touchdown is
+    /// near enough for it to count.
+    fn touchdown_confirmed(
+        &mut self,
+        feedback: &Feedback,
+        phase: &SupportPhase,
+        foot: usize,
+    ) -> bool {
+        let pressed = feedback.normal_forces[foot] > self.touchdown_force;
+        self.debounce = if pressed { self.debounce + 1 } else { 0 };
+        let due = self.clock >= phase.end_s() - self.plan().config.early_touchdown_s;
+        due && self.debounce >= self.config.touchdown_debounce_ticks
+    }
+
+    /// Anchors a foot where it landed, at its contact surface's height.
+    fn land(&mut self, foot: EndEffector, feedback: &Feedback) {
+        let e = foot as usize;
+        let planned = self.swing.map_or(feedback.poses[e].translation.z, |s| {
+            s.trajectory.landing().translation.z + self.plan().config.landing_depth_m
+        });
+        let mut anchor = feedback.poses[e];
+        anchor.translation.z = planned;
+        self.targets.contacts[e] = true;
+        self.targets.anchors[e] = anchor;
+        self.swing = None;
+    }
+
+    /// Releases `foot` and starts its swing (the next phase's).
+    fn lift_off(&mut self, foot: EndEffector, feedback: &Feedback) {
+        let next = self.plan().footsteps.phases[self.phase + 1];
+        let Support::Single(plan) = next.support else {
+            unreachable!("a lift-off is followed by its swing");
+        };
+        debug_assert_eq!(plan.foot, foot);
+        let depth = self.plan().config.landing_depth_m;
+        let mut landing = self.to_world * plan.landing;
+        landing.translation.z -= depth;
+        let trajectory = SwingTrajectory::new(
+            feedback.poses[foot as usize],
+            self.to_world * plan.apex,
+            landing,
+            next.duration_s,
+        );
+        self.targets.contacts[foot as usize] = false;
+        self.swing = Some(Swing {
+            foot,
+            trajectory,
+            lift_off_s: next.start_s,
+        });
+    }
+
+    fn next_phase(&mut self, feedback: &Feedback) {
+        self.phase += 1;
+        self.debounce = 0;
+        self.late_s = None;
+        let ends_transition = self
+            .plan()
+            .footsteps
+            .transitions
+            .get(self.transition)
+            .is_some_and(|t| t.phases.end == self.phase);
+        if ends_transition {
+            self.finish_transition();
+            self.transition += 1;
+            self.begin_transition(feedback);
+        }
+    }
+
+    /// Releases the hands the next stance lets go of and starts the reaches of those it adds.
+    fn begin_transition(&mut self, feedback: &Feedback) {
+        let plan = self.plan();
+        let Some(transition) = plan.footsteps.transitions.get(self.transition) else {
+            return;
+        };
+        let phases = &plan.footsteps.phases;
+        let start = phases[transition.phases.start].start_s;
+        let duration = phases[transition.phases.end - 1].end_s() - start;
+        let stance = &self.sequence.as_ref().expect("loaded").stances[transition.stance];
+        let (contacts, targets) = (stance.contacts, stance.targets);
+        for (k, hand) in HANDS.iter().enumerate() {
+            let h = *hand as usize;
+            if self.targets.contacts[h] && !contacts[h] {
+                self.targets.contacts[h] = false;
+                if self.config.carry_released_hands {
+                    self.carried[k] =
+                        Some(heading_frame(&feedback.pelvis).inverse() * self.targets.anchors[h]);
+                }
+            } else if !self.targets.contacts[h] && contacts[h] {
+                let goal = self.to_world * targets[h];
+                let reach =
+                    PoseTrajectory::new(feedback.poses[h], goal, duration, Profile::MinimumJerk);
+                self.reaches[k] = Some((reach, start));
+            }
+        }
+    }
+
+    /// The hands that reached are in contact.
+    fn finish_transition(&mut self) {
+        for (k, hand) in HANDS.iter().enumerate() {
+            if let Some((reach, _)) = self.reaches[k].take() {
+                let h = *hand as usize;
+                self.targets.contacts[h] = true;
+                self.targets.anchors[h] = *reach.goal();
+                self.carried[k] = None;
+            }
+        }
+    }
+
+    /// After the plan: done once the CoM and the commanded DCM rest over the final feet.
+    fn settle(&mut self, feedback: &Feedback) -> Progress {
+        let rest = self.plan().pattern.rest();
+        let tolerance = self.config.com_tolerance_m;
+        let at_rest = (feedback.com.xy() - rest).norm() <= tolerance
+            && (self.stabilizer.pendulum().dcm - rest).norm() <= tolerance;
+        if at_rest {
+            Progress::Done
+        } else if self.settle_s > self.config.phase_timeout_s {
+            Progress::Fault(FaultCode::Timeout(Phase::Settle))
+        } else {
+            Progress::Running
+        }
+    }
+
+    /// Measures ZMP and DCM, runs the stabilizer and the foot compliance.
+    fn stabilize(&mut self, feedback: &Feedback, sensors: &Sensors, dt: f64) {
+        if self.current_phase().is_none() {
+            self.settle_s += dt;
+        }
+        let plan = self.plan();
+        let (config, omega) = (plan.config.stabilizer, plan.pattern.omega());
+        let mut cursor = self.cursor;
+        let reference = plan.pattern.sample(self.clock, &mut cursor);
+        self.cursor = cursor;
+        let ground = self.ground_height();
+        let foot_wrenches = || {
+            FEET.iter()
+                .zip(&sensors.ft_origins)
+                .map(|(f, o)| (&sensors.wrenches[*f as usize], o))
+        };
+        let zmp = pressure_centre(foot_wrenches(), ground, self.touchdown_force);
+        let mut com = feedback.com;
+        if let (true, Some(imu)) = (config.imu_tilt, sensors.imu) {
+            let pivot = zmp.unwrap_or(reference.zmp);
+            let pivot = Vector3::new(pivot.x, pivot.y, ground);
+            com = tilted_com(&com, &pivot, &imu, &sensors.base_rotation);
+        }
+        let dcm = self
+            .estimator
+            .update(com.xy(), dt, omega, config.velocity_filter_s);
+        self.set_support();
+        let measured = Measured { dcm, zmp };
+        let command = self
+            .stabilizer
+            .update(&reference, &measured, &self.support, dt);
+        self.targets.com = command.com;
+        self.targets.com_velocity = command.com_velocity;
+        self.targets.balance = Balance::ComHeight(ground + self.plan().com_height);
+        self.comply(command.zmp, sensors, ground, dt);
+        let offset = self.stabilizer.zmp_offset();
+        let xy = |v: Vector2<f64>| [v.x, v.y];
+        self.balance = BalanceStatus {
+            zmp_reference: xy(reference.zmp),
+            zmp_desired: xy(command.zmp),
+            zmp_measured: zmp.map_or([f64::NAN; 2], xy),
+            dcm_reference: xy(reference.dcm),
+            dcm_measured: xy(dcm + offset),
+            com_offset: xy(offset),
+        };
+    }
+
+    /// Foot damping, force difference and tilt damping as contact velocities for the desired ZMP
+    /// `zmp`.
+    fn comply(&mut self, zmp: Vector2<f64>, sensors: &Sensors, ground: f64, dt: f64) {
+        let config = self.plan().config.stabilizer;
+        self.targets.contact_velocity = [[0.0; 6]; 2];
+        let feet = FEET.map(|f| {
+            let e = f as usize;
+            self.targets.contacts[e].then_some(&self.targets.anchors[e])
+        });
+        let loads = distribute(zmp, feet, &self.sole, config.zmp_margin_m);
+        let forces = FEET.map(|f| sensors.wrenches[f as usize][2]);
+        let total: f64 = (0..2)
+            .filter(|&f| feet[f].is_some())
+            .map(|f| forces[f])
+            .sum();
+        for f in 0..2 {
+            let (Some(load), true) = (loads[f], config.foot_damping) else {
+                self.foot_turn[f] = Vector2::zeros();
+                continue;
+            };
+            let wrench = [(&sensors.wrenches[FEET[f] as usize], &sensors.ft_origins[f])];
+            if let Some(cop) = pressure_centre(wrench, ground, 0.5 * self.touchdown_force) {
+                let turn = foot_damping(load.cop, cop, forces[f], self.foot_turn[f], &config);
+                self.foot_turn[f] += turn * dt;
+                self.targets.contact_velocity[f][3] = turn.x;
+                self.targets.contact_velocity[f][4] = turn.y;
+            }
+        }
+        if let (true, [Some(left), Some(right)]) = (config.force_difference, loads) {
+            let desired = [left.share * total, right.share * total];
+            let v = force_difference(desired, forces, &config);
+            self.targets.contact_velocity[0][2] = -v / 2.0;
+            self.targets.contact_velocity[1][2] = v / 2.0;
+        }
+        if let (true, Some(imu)) = (config.tilt_damping, &sensors.imu) {
+            let rate = self.tilt_rate.update(imu, dt, config.tilt_rate_filter_s);
+            let (gain, max) = (config.tilt_damping_s, config.tilt_damping_max_rad);
+            let turn = self.tilt_damping.velocity(rate, gain, max, dt);
+            for (f, velocity) in self.targets.contact_velocity.iter_mut().enumerate() {
+                if feet[f].is_some() {
+                    velocity[3] += turn.x;
+                    velocity[4] += turn.y;
+                }
+            }
+        }
+    }
+
+    /// Mean height of the feet in contact (the surface the pendulum stands on).
+    fn ground_height(&self) -> f64 {
+        let (sum, count) = FEET
+            .iter()
+            .filter(|f| self.targets.contacts[**f as usize])
+            .fold((0.0, 0.0), |(sum, n), f| {
+                (
+                    sum + self.targets.anchors[*f as usize].translation.z,
+                    n + 1.0,
+                )
+            });
+        if count > 0.0 { sum / count } else { 0.0 }
+    }
+
+    /// The polygon of the feet in contact.
+    fn set_support(&mut self) {
+        let mut corners = [[0.0; 2]; 8];
+        let mut count = 0;
+        for foot in FEET {
+            if !self.targets.contacts[foot as usize] {
+                continue;
+            }
+            for corner in sole_corners(&self.targets.anchors[foot as usize], &self.sole) {
+                corners[count] = [corner.x, corner.y];
+                count += 1;
+            }
+        }
+        self.support.set_hull(&corners[..count]);
+    }
+
+    fn refresh_targets(&mut self, pelvis: &Isometry3<f64>) {
+        for foot in FEET {
+            self.targets.end_effectors[foot as usize] = None;
+        }
+        if let Some(swing) = &self.swing {
+            let (mut pose, mut velocity) = swing.trajectory.sample(self.clock - swing.lift_off_s);
+            if let Some(late) = self.late_s {
+                let speed = self.plan().config.late_descent_speed;
+                pose.translation.z -= speed * late;
+                velocity = [0.0, 0.0, -speed, 0.0, 0.0, 0.0];
+            }
+            self.targets.end_effectors[swing.foot as usize] = Some(PoseTarget { pose, velocity });
+        }
+        for (k, hand) in HANDS.iter().enumerate() {
+            let h = *hand as usize;
+            self.targets.end_effectors[h] = if self.targets.contacts[h] {
+                Some(PoseTarget {
+                    pose: self.targets.anchors[h],
+                    velocity: [0.0; 6],
+                })
+            } else if let Some((reach, start)) = &self.reaches[k] {
+                let (pose, velocity) = reach.sample(self.clock - start);
+                Some(PoseTarget { pose, velocity })
+            } else {
+                self.carried[k].map(|relative| PoseTarget {
+                    pose: heading_frame(pelvis) * relative,
+                    velocity: [0.0; 6],
+                })
+            };
+        }
+    }
+}

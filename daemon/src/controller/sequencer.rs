@@ -1,0 +1,146 @@
+//! The state machine of the last loaded sequence's gait behind one interface: the static gait's
+//! [`StateMachine`] (which also holds the contact set between walks) or the [`DynamicWalker`].
+//! A dynamic walk takes over the static machine's contacts when it starts and hands them back
+//! when it ends, however it ends.
+
+use kinematics::robot::{EndEffector, SoleRectangle};
+use nalgebra::{DVector, Isometry3};
+
+use super::config::ControllerConfig;
+use super::gait::{DynamicWalker, Sensors};
+use super::machine::{Feedback, Progress, StateMachine, Targets};
+use super::sequence::PreparedSequence;
+use super::status::{BalanceStatus, Phase};
+
+/// Both gaits' state machines; see the module docs.
+pub(crate) struct Sequencer {
+    fallback: StateMachine,
+    dynamic: DynamicWalker,
+    /// The last loaded sequence is a dynamic one.
+    dynamic_selected: bool,
+}
+
+impl Sequencer {
+    /// Machines for a robot of weight `weight_n` (N) with soles `sole`.
+    pub fn new(config: &ControllerConfig, sole: SoleRectangle, weight_n: f64) -> Self {
+        let fallback = StateMachine::new(config, sole, weight_n);
+        let dynamic = DynamicWalker::new(config, sole, weight_n, *fallback.targets());
+        Self {
+            fallback,
+            dynamic,
+            dynamic_selected: false,
+        }
+    }
+
+    /// Declares the feet standing when the world frame is set up (anchored at `poses`).
+    pub fn set_standing(&mut self, standing: [bool; 2], poses: &[Isometry3<f64>; 4]) {
+        self.fallback.set_standing(standing, poses);
+    }
+
+    /// Whether the current contacts suit `sequence`: a dynamic walk starts on both feet.
+    pub fn on_both_feet_for(&self, sequence: &PreparedSequence) -> bool {
+        sequence.dynamic.is_none() || on_both_feet(self.fallback.targets())
+    }
+
+    /// Installs a sequence to execute from the next update; returns the previous one of its gait.
+    pub fn load(&mut self, sequence: Box<PreparedSequence>) -> Option<Box<PreparedSequence>> {
+        self.dynamic_selected = sequence.dynamic.is_some();
+        if self.dynamic_selected {
+            self.dynamic.load(sequence)
+        } else {
+            self.fallback.load(sequence)
+        }
+    }
+
+    /// Stops executing; the contact set and anchors stay as they are.
+    pub fn stop(&mut self) {
+        if self.dynamic.running() {
+            self.dynamic.stop();
+            self.fallback.adopt(self.dynamic.targets());
+        }
+        self.fallback.stop();
+    }
+
+    /// One tick of the running sequence. `sensors` is called only for a dynamic walk.
+    pub fn update<'a>(
+        &mut self,
+        feedback: &Feedback,
+        sensors: impl FnOnce() -> Sensors<'a>,
+        dt: f64,
+    ) -> Progress {
+        if !self.dynamic.running() {
+            return self.fallback.update(feedback, dt);
+        }
+        if !self.dynamic.started() {
+            self.dynamic.take_over(self.fallback.targets());
+        }
+        let progress = self.dynamic.update(feedback, &sensors(), dt);
+        if progress != Progress::Running {
+            self.fallback.adopt(self.dynamic.targets());
+        }
+        progress
+    }
+
+    /// The live contact set, anchors and set-points: the dynamic walk's while it runs, else the
+    /// static machine's (which takes a dynamic walk's over when it ends).
+    pub fn targets(&self) -> &Targets {
+        if self.dynamic.started() {
+            self.dynamic.targets()
+        } else {
+            self.fallback.targets()
+        }
+    }
+
+    /// World anchors of the feet in contact, for the estimator.
+    pub fn foot_anchors(&self) -> [Option<&Isometry3<f64>>; 2] {
+        self.targets().foot_anchors()
+    }
+
+    /// The posture reference of the stance being moved towards.
+    pub fn posture(&self) -> Option<&DVector<f64>> {
+        if self.dynamic_selected {
+            self.dynamic.posture()
+        } else {
+            self.fallback.posture()
+        }
+    }
+
+    /// Current phase.
+    pub fn phase(&self) -> Phase {
+        if self.dynamic_selected {
+            self.dynamic.phase()
+        } else {
+            self.fallback.phase()
+        }
+    }
+
+    /// Index of the stance being moved towards and the stance count.
+    pub fn progress(&self) -> (usize, usize) {
+        if self.dynamic_selected {
+            self.dynamic.progress()
+        } else {
+            self.fallback.progress()
+        }
+    }
+
+    /// The QP tuning of the running gait: `config`, with the dynamic gait's overrides while a
+    /// dynamic walk runs.
+    pub fn qp_config(&self, config: &ControllerConfig) -> ControllerConfig {
+        if self.dynamic.started() {
+            self.dynamic.qp_config(config)
+        } else {
+            *config
+        }
+    }
+
+    /// The dynamic walk's balance readings (kept after it ended, zero before the first).
+    pub fn balance(&self) -> &BalanceStatus {
+        self.dynamic.balance()
+    }
+}
+
+/// Both feet are in the contact set.
+pub(crate) fn on_both_feet(targets: &Targets) -> bool {
+    targets.contacts[EndEffector::LeftFoot as usize]
+        && targets.contacts[EndEffector::RightFoot as usize]
+}
