@@ -7,12 +7,19 @@
 //! - `physics` (feature `mujoco`): a walk under MuJoCo with fall detection, drift and the paper's
 //!   Fig. 6 trace.
 //!
-//! Binaries: `walk-bench` (a walk as fast as the machine runs) and `latency-report` (latency and
-//! deadline misses of the real multi-process system). This crate, not `daemon`, links the
+//! - `matrix` (feature `mujoco`): `physics-matrix`, those walks over affordance sets ×
+//!   distances × seeds with config overrides, model error and pushes.
+//!
+//! Binaries: `walk-bench` (a walk as fast as the machine runs), `physics-matrix` (feature
+//! `mujoco`) and `latency-report` (latency and deadline misses of the real multi-process
+//! system). This crate, not `daemon`, links the
 //! simulators: walkd itself links none.
 
 pub mod closed_loop;
 pub mod command;
+/// `physics-matrix`: in-process MuJoCo walks over a matrix (feature `mujoco`).
+#[cfg(feature = "mujoco")]
+pub mod matrix;
 /// The controller walking under MuJoCo physics, in one process (feature `mujoco`).
 #[cfg(feature = "mujoco")]
 pub mod physics;

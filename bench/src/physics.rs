@@ -30,9 +30,7 @@ use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Vector2, Vector3};
 use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim};
 use stance::poses::FEET;
-use stance::{
-    AffordanceSet, PostProcessParams, PostProcessedSequence, WalkRequest, synthetic_walk,
-};
+use stance::{PostProcessParams, PostProcessedSequence, WalkRequest, synthetic_walk};
 
 use crate::closed_loop::{ClosedLoop, TickError, feet_midpoint};
 
@@ -251,32 +249,24 @@ impl PhysicsWalkReport {
     }
 }
 
-/// Generates a forward walk of `distance` metres for the robot of `config` (seeded), post-
-/// processes it with the config's `[postprocess]` section and walks it under physics.
+/// Generates the walk of `request` for the robot of `config`, post-processes it with the
+/// parameters of `options.gait` and walks it under physics.
 pub fn walk_distance(
-    config: &Path,
+    config: &ConfigFile,
     urdf: Option<&Path>,
-    distance: f64,
-    affordances: AffordanceSet,
-    seed: u64,
+    request: &WalkRequest,
     options: &PhysicsWalkOptions,
 ) -> anyhow::Result<PhysicsWalkReport> {
-    let file = ConfigFile::load(config)?;
     let robot = Arc::new(
-        Robot::from_config(&file, urdf).with_context(|| format!("loading {}", config.display()))?,
+        Robot::from_config(config, urdf).with_context(|| format!("loading {}", config.origin()))?,
     );
-    let params = PostProcessParams::from_config_for(&file, options.gait)?;
-    let controller_config = ControllerConfig::from_config(&file)?;
-    let mut gaits = GaitConfig::from_config(&file)?;
+    let params = PostProcessParams::from_config_for(config, options.gait)?;
+    let controller_config = ControllerConfig::from_config(config)?;
+    let mut gaits = GaitConfig::from_config(config)?;
     if options.dynamic.is_some() {
         gaits.dynamic = options.dynamic;
     }
-    let request = WalkRequest {
-        distance,
-        affordances,
-        seed,
-    };
-    let sequence = synthetic_walk(&robot, &params, &request)?;
+    let sequence = synthetic_walk(&robot, &params, request)?;
     walk_sequence(robot, controller_config, &gaits, &sequence, options)
 }
 

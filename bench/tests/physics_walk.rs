@@ -23,16 +23,21 @@ fn physics_walk_needs_the_mujoco_feature() {
 #[cfg(feature = "mujoco")]
 mod walks {
     use client::evaluate::write_fig6;
-    use stance::AffordanceSet;
+    use stance::{AffordanceSet, WalkRequest};
     use walk_bench::physics::{
         PhysicsWalkOptions, PhysicsWalkReport, walk_distance, walk_sequence,
     };
 
     /// `configs/<robot>.toml`.
-    fn config(robot: &str) -> std::path::PathBuf {
+    fn config_path(robot: &str) -> std::path::PathBuf {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../configs")
             .join(format!("{robot}.toml"))
+    }
+
+    /// `configs/<robot>.toml`, loaded.
+    fn config(robot: &str) -> kinematics::ConfigFile {
+        kinematics::ConfigFile::load(&config_path(robot)).expect("vendored config loads")
     }
 
     /// The walk must end with each simulated sole this close to its final target (m). Each
@@ -47,7 +52,12 @@ mod walks {
     /// `target/tmp/fig6_<robot>_<affordances>_<distance>m.svg`.
     fn walk(robot: &str, affordances: AffordanceSet, distance: f64) -> PhysicsWalkReport {
         let options = PhysicsWalkOptions::default();
-        let report = walk_distance(&config(robot), None, distance, affordances, 0, &options)
+        let request = WalkRequest {
+            distance,
+            affordances,
+            seed: 0,
+        };
+        let report = walk_distance(&config(robot), None, &request, &options)
             .unwrap_or_else(|e| panic!("{robot} {}: {e:#}", affordances.name()));
         let plot = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
             "fig6_{robot}_{}_{distance}m.svg",
@@ -169,16 +179,16 @@ mod walks {
     /// Sequences from the learned n-gram model (`data/models/default-ngram.json`, retargeted and
     /// post-processed) walk under physics too: each affordance set, 1 m, seed 0.
     fn check_learned(robot: &str) {
-        let config_path = config(robot);
+        let config = config(robot);
         let robot_model = std::sync::Arc::new(
-            kinematics::robot::Robot::load(&config_path, None).expect("robot loads"),
+            kinematics::robot::Robot::from_config(&config, None).expect("robot loads"),
         );
-        let params = stance::PostProcessParams::from_config_path(&config_path).unwrap();
+        let params = stance::PostProcessParams::from_config(&config).unwrap();
         let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../data/models/default-ngram.json");
         let source = stance::learned::StanceSource::learned(&model, None).expect("model loads");
-        let controller = daemon::controller::ControllerConfig::from_config_file(&config_path)
-            .expect("controller config");
+        let controller =
+            daemon::controller::ControllerConfig::from_config(&config).expect("controller config");
         for affordances in [
             AffordanceSet::Feet,
             AffordanceSet::FeetLeftHand,
@@ -218,15 +228,9 @@ mod walks {
     fn check_dynamic(distance: f64, min_speed: f64) {
         let options = PhysicsWalkOptions::dynamic();
         for seed in [0, 1] {
-            let report = walk_distance(
-                &config("jvrc1"),
-                None,
-                distance,
-                AffordanceSet::Feet,
-                seed,
-                &options,
-            )
-            .unwrap_or_else(|e| panic!("jvrc1 dynamic seed {seed}: {e:#}"));
+            let request = WalkRequest::feet(distance, seed);
+            let report = walk_distance(&config("jvrc1"), None, &request, &options)
+                .unwrap_or_else(|e| panic!("jvrc1 dynamic seed {seed}: {e:#}"));
             let name = format!("jvrc1 dynamic seed {seed}");
             print_report(&name, distance, &report);
             assert!(

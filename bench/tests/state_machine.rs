@@ -241,7 +241,7 @@ fn sequences_with_an_overlong_step_or_another_robot_are_refused() {
 }
 
 #[test]
-fn an_imu_that_disagrees_with_leg_odometry_is_a_tipping_fault_that_holds() {
+fn an_imu_tilted_away_from_leg_odometry_is_a_tipping_fault_that_holds() {
     let mut h = started("jvrc1", false);
     for _ in 0..50 {
         h.tick();
@@ -252,19 +252,22 @@ fn an_imu_that_disagrees_with_leg_odometry_is_a_tipping_fault_that_holds() {
     );
     let config = walk_support::controller_config("jvrc1");
     let m = h.closed.sim.measurement().clone();
-    // The IMU reports the base rolled just under, then just over, the detection angle.
-    let roll = |angle: f64| {
-        nalgebra::UnitQuaternion::from_euler_angles(angle, 0.0, 0.0) * m.base_orientation
+    // The IMU reports the base turned about the vertical by twice the detection angle (a stance
+    // foot slipping round: no tipping), then rolled just under, then just over, that angle.
+    let turned = |roll: f64, yaw: f64| {
+        nalgebra::UnitQuaternion::from_euler_angles(roll, 0.0, yaw) * m.base_orientation
     };
-    for (angle, tipping) in [
-        (0.9 * config.tipping_detection_rad, false),
-        (1.1 * config.tipping_detection_rad, true),
+    let detection = config.tipping_detection_rad;
+    for (imu, tipping) in [
+        (turned(0.0, 2.0 * detection), false),
+        (turned(0.9 * detection, 0.0), false),
+        (turned(1.1 * detection, 0.0), true),
     ] {
         let measurement = daemon::controller::Measurement {
             q: m.q.as_slice(),
             qd: m.qd.as_slice(),
             wrenches: &m.wrenches,
-            imu_orientation: Some(roll(angle)),
+            imu_orientation: Some(imu),
         };
         let before = h.closed.command.q_des.clone();
         assert!(

@@ -38,6 +38,16 @@ pub enum ConfigFileError {
         /// The parser's message (line and column).
         message: String,
     },
+    /// An override (`section.key=value`) is malformed or names no section.
+    #[error("{path}: override `{assignment}`: {message}")]
+    Override {
+        /// The file overridden.
+        path: PathBuf,
+        /// The override as given.
+        assignment: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A top-level key is not one of [`SECTIONS`].
     #[error("{path}: unknown section [{name}] (a robot config has {})", SECTIONS.join(", "))]
     UnknownSection {
@@ -93,6 +103,52 @@ impl ConfigFile {
         self.path.parent().unwrap_or(Path::new(".")).join(relative)
     }
 
+    /// Replaces one value, `assignment` being `section.key=value` with a dotted path into the
+    /// file (`gait.dynamic.single_support_s=0.5`, `postprocess.dynamic.s_max=0.45`) and a TOML
+    /// value (a bare word is taken as a string). Tables on the way are created; the section
+    /// must be one of [`SECTIONS`]. The key is checked when its section is read, like the
+    /// file's own keys. For experiments and sweeps that vary a parameter without editing the
+    /// config.
+    pub fn set(&mut self, assignment: &str) -> Result<(), ConfigFileError> {
+        let fail = |message: &str| ConfigFileError::Override {
+            path: self.path.clone(),
+            assignment: assignment.to_owned(),
+            message: message.to_owned(),
+        };
+        let (key, text) = assignment
+            .split_once('=')
+            .ok_or_else(|| fail("expected section.key=value"))?;
+        let path: Vec<&str> = key.trim().split('.').collect();
+        if path.len() < 2 || path.iter().any(|part| part.is_empty()) {
+            return Err(fail("expected section.key=value"));
+        }
+        if !SECTIONS.contains(&path[0]) {
+            return Err(fail(&format!(
+                "unknown section [{}] (a robot config has {})",
+                path[0],
+                SECTIONS.join(", ")
+            )));
+        }
+        let text = text.trim();
+        let value = format!("v = {text}")
+            .parse::<toml::Table>()
+            .ok()
+            .and_then(|mut table| table.remove("v"))
+            .unwrap_or_else(|| toml::Value::String(text.to_owned()));
+        let (last, tables) = path.split_last().expect("at least two parts");
+        let mut table = &mut self.table;
+        for part in tables {
+            let entry = table
+                .entry(part.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            table = entry
+                .as_table_mut()
+                .ok_or_else(|| fail(&format!("`{part}` is a value, not a table")))?;
+        }
+        table.insert(last.to_string(), value);
+        Ok(())
+    }
+
     /// A section, if the file has it.
     pub fn section(&self, name: &str) -> Option<&toml::Value> {
         debug_assert!(SECTIONS.contains(&name), "unknown section {name}");
@@ -116,6 +172,31 @@ mod tests {
         let file = ConfigFile::parse("[runtime]\nx = 1\n", Path::new("dir/r.toml")).unwrap();
         assert!(file.section("runtime").is_some() && file.section("robot").is_none());
         assert_eq!(file.resolve(Path::new("a.urdf")), Path::new("dir/a.urdf"));
+    }
+
+    #[test]
+    fn overrides_replace_or_add_values_in_known_sections() {
+        let mut file = ConfigFile::parse(
+            "[gait.dynamic]\nsingle_support_s = 0.7\n",
+            Path::new("r.toml"),
+        )
+        .unwrap();
+        file.set("gait.dynamic.single_support_s=0.5").unwrap();
+        file.set("gait.default = dynamic").unwrap();
+        file.set("postprocess.dynamic.s_max=0.45").unwrap();
+        let gait = file.section("gait").unwrap();
+        assert_eq!(gait["dynamic"]["single_support_s"].as_float(), Some(0.5));
+        assert_eq!(gait["default"].as_str(), Some("dynamic"));
+        let postprocess = file.section("postprocess").unwrap();
+        assert_eq!(postprocess["dynamic"]["s_max"].as_float(), Some(0.45));
+        for (bad, named) in [
+            ("gait.dynamic.single_support_s", "section.key=value"),
+            ("gaet.default=static", "[gaet]"),
+            ("gait.dynamic.single_support_s.x=1", "is a value"),
+        ] {
+            let error = file.set(bad).unwrap_err().to_string();
+            assert!(error.contains(named) && error.contains("r.toml"), "{error}");
+        }
     }
 
     #[test]

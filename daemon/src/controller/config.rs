@@ -104,9 +104,10 @@ pub struct ControllerConfig {
     /// Task weight of a foot while it unloads: out of the contact set but still on the ground,
     /// so it must rise straight up rather than slide (usually well above `foot_weight`).
     pub unload_foot_weight: f64,
-    /// The robot is tipping when the IMU's base orientation and the leg-odometry estimate differ
-    /// by more than this angle (rad): the stance feet are no longer flat on the ground. Only
-    /// checked when the measurement has an IMU.
+    /// The robot is tipping when the IMU's base tilt and the leg-odometry estimate's differ
+    /// by more than this angle (rad; the angle between their vertical axes, so yaw does not
+    /// count): the stance feet are no longer flat on the ground. Only checked when the
+    /// measurement has an IMU.
     pub tipping_detection_rad: f64,
     /// Whether a hand that lets go is carried along with the pelvis, as it held, until its next
     /// reach, instead of being left to the posture task. Returning to the posture at once

@@ -570,11 +570,15 @@ impl Controller {
         ok
     }
 
-    /// The IMU sees the base turned away from where leg odometry puts it: the anchored feet are
-    /// no longer flat on the ground.
+    /// The IMU sees the base tilted away from where leg odometry puts it: the anchored feet are
+    /// no longer flat on the ground. Only the tilt counts (the angle between the two vertical
+    /// axes): a stance foot turning about the vertical makes the yaws differ without any
+    /// tipping.
     fn tipping(&self, measurement: &Measurement) -> bool {
         measurement.imu_orientation.is_some_and(|imu| {
-            imu.angle_to(&self.configuration.base.rotation) > self.config.tipping_detection_rad
+            let up = nalgebra::Vector3::z();
+            let estimated = self.configuration.base.rotation * up;
+            (imu * up).angle(&estimated) > self.config.tipping_detection_rad
         })
     }
 
