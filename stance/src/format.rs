@@ -12,8 +12,9 @@
 //!                 "translation": [x, y, z], "root_orientation": [x, y, z, w],
 //!                 "targets": { "left_foot": { "translation": [..], "rotation": [..] }, .. } }] }
 //! ```
-//! `targets` is present exactly in post-processed files; `root_orientation` defaults to the
-//! identity. Unknown fields are errors. Quaternions are `[x, y, z, w]`.
+//! `targets` is present exactly in post-processed files; so is the optional `"gait": "static" |
+//! "dynamic"`, the gait whose limits post-processed the sequence and that walks it (absent: the
+//! robot config's default). `root_orientation` defaults to the identity. Unknown fields are errors. Quaternions are `[x, y, z, w]`.
 
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
@@ -22,6 +23,7 @@ use serde::{Deserialize, Serialize};
 use crate::environment::{Environment, HandAffordance, SupportSurface};
 use crate::error::{FormatError, Location};
 use crate::json_path::{location_at, offset_of};
+use crate::params::Gait;
 use crate::sequence::{PostProcessedSequence, RawSequence, Stance, StanceSequence};
 
 /// The file format version this build writes and reads.
@@ -51,6 +53,8 @@ struct FileDto {
     robot: String,
     joint_names: Vec<String>,
     environment: EnvironmentDto,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    gait: Option<Gait>,
     stances: Vec<StanceDto>,
 }
 
@@ -283,6 +287,7 @@ fn for_robot<S: std::ops::Deref<Target = StanceSequence>>(
 fn file_dto<'a>(
     sequence: &StanceSequence,
     kind: Kind,
+    gait: Option<Gait>,
     targets: impl Fn(usize) -> Option<&'a [Isometry3<f64>; 4]>,
 ) -> FileDto {
     FileDto {
@@ -291,6 +296,7 @@ fn file_dto<'a>(
         robot: sequence.robot.clone(),
         joint_names: sequence.joint_names.clone(),
         environment: (&sequence.environment).into(),
+        gait,
         stances: sequence
             .stances
             .iter()
@@ -362,7 +368,10 @@ fn parse_file(text: &str, expected: Kind) -> Result<FileDto, FormatError> {
 
 type Parts = (String, Vec<String>, Environment, Vec<Stance>);
 
-fn into_parts(file: FileDto) -> Result<(Parts, Vec<Option<TargetsDto>>), FormatError> {
+/// The stances, their targets if any, and the gait if the file names one.
+type FileParts = (Parts, Vec<Option<TargetsDto>>, Option<Gait>);
+
+fn into_parts(file: FileDto) -> Result<FileParts, FormatError> {
     let mut stances = Vec::with_capacity(file.stances.len());
     let mut targets = Vec::with_capacity(file.stances.len());
     for (i, dto) in file.stances.into_iter().enumerate() {
@@ -382,7 +391,7 @@ fn into_parts(file: FileDto) -> Result<(Parts, Vec<Option<TargetsDto>>), FormatE
         file.environment.into(),
         stances,
     );
-    Ok((parts, targets))
+    Ok((parts, targets, file.gait))
 }
 
 fn stance_dto(stance: &Stance, targets: Option<&[Isometry3<f64>; 4]>) -> StanceDto {
@@ -408,11 +417,19 @@ fn write(file: &FileDto) -> String {
 impl RawSequence {
     /// Reads and validates a raw stance file without checking it against a robot.
     pub fn parse_json_str(text: &str) -> Result<Self, FormatError> {
-        let (parts, targets) = into_parts(parse_file(text, Kind::Raw)?)?;
+        let (parts, targets, gait) = into_parts(parse_file(text, Kind::Raw)?)?;
         if let Some(i) = targets.iter().position(Option::is_some) {
             return Err(FormatError::Invalid {
                 location: Location::stance(i, "targets"),
                 message: "a raw stance has no targets (is this a post-processed file?)".into(),
+            });
+        }
+        if gait.is_some() {
+            return Err(FormatError::Invalid {
+                location: Location::file("gait"),
+                message: "a raw sequence has no gait: the gait is chosen when it is \
+                          post-processed"
+                    .into(),
             });
         }
         let (robot, joint_names, environment, stances) = parts;
@@ -426,14 +443,14 @@ impl RawSequence {
 
     /// The sequence as a (pretty-printed) stance file.
     pub fn to_json_string(&self) -> String {
-        write(&file_dto(self, Kind::Raw, |_| None))
+        write(&file_dto(self, Kind::Raw, None, |_| None))
     }
 }
 
 impl PostProcessedSequence {
     /// Reads and validates a post-processed stance file without checking it against a robot.
     pub fn parse_json_str(text: &str) -> Result<Self, FormatError> {
-        let (parts, targets) = into_parts(parse_file(text, Kind::PostProcessed)?)?;
+        let (parts, targets, gait) = into_parts(parse_file(text, Kind::PostProcessed)?)?;
         let targets = targets
             .into_iter()
             .enumerate()
@@ -448,7 +465,10 @@ impl PostProcessedSequence {
             })
             .collect::<Result<Vec<_>, FormatError>>()?;
         let (robot, joint_names, environment, stances) = parts;
-        PostProcessedSequence::new(robot, joint_names, environment, stances, targets)
+        Ok(
+            PostProcessedSequence::new(robot, joint_names, environment, stances, targets)?
+                .with_gait(gait),
+        )
     }
 
     /// Reads a post-processed stance file and checks that it is for `robot`. This is the
@@ -459,7 +479,7 @@ impl PostProcessedSequence {
 
     /// The sequence as a (pretty-printed) stance file.
     pub fn to_json_string(&self) -> String {
-        write(&file_dto(self, Kind::PostProcessed, |i| {
+        write(&file_dto(self, Kind::PostProcessed, self.gait, |i| {
             Some(&self.targets[i])
         }))
     }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use kinematics::ConfigFile;
 use kinematics::ConfigFileError;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// How a run of contacts of one end-effector is made static (pass 2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
@@ -21,7 +21,7 @@ pub enum ContactUnification {
 /// How a sequence is walked: each gait post-processes with its own limits (a dynamic walk
 /// takes longer steps than a statically stable one), so the choice is made before
 /// post-processing and travels with the sequence to the controller.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Gait {
     /// Quasi-static: the CoM stays over the support polygon; contact changes wait for targets
@@ -79,6 +79,10 @@ pub struct PostProcessParams {
     /// Pass 2 variant; `first` unless the config says `contact_unification = "mean"`.
     #[serde(default)]
     pub contact_unification: ContactUnification,
+    /// The gait these limits are for (`[postprocess]`: static, with `[postprocess.dynamic]`:
+    /// dynamic); the post-processed sequence carries it to the controller.
+    #[serde(skip)]
+    pub gait: Gait,
 }
 
 /// Why the `[postprocess]` section could not be used.
@@ -165,7 +169,10 @@ impl PostProcessParams {
         let static_params = parse(section.clone(), "postprocess", origin.clone())?;
         section.extend(overrides);
         let dynamic_origin = format!("{origin} (with [postprocess.{DYNAMIC_OVERRIDES}])");
-        let dynamic_params = parse(section, "postprocess.dynamic", dynamic_origin)?;
+        let dynamic_params = Self {
+            gait: Gait::Dynamic,
+            ..parse(section, "postprocess.dynamic", dynamic_origin)?
+        };
         Ok(match gait {
             Gait::Static => static_params,
             Gait::Dynamic => dynamic_params,
@@ -261,17 +268,26 @@ mod tests {
         )
         .unwrap();
         assert_eq!(
-            (dynamic.s_max, dynamic.scf, dynamic.h_max),
-            (0.45, 0.3, 0.1)
+            (dynamic.s_max, dynamic.scf, dynamic.h_max, dynamic.gait),
+            (0.45, 0.3, 0.1, Gait::Dynamic)
         );
         let fixed = PostProcessParams::from_config_str(&text, path).unwrap();
-        assert_eq!((fixed.s_max, fixed.scf), (0.3, 0.4));
+        assert_eq!(
+            (fixed.s_max, fixed.scf, fixed.gait),
+            (0.3, 0.4, Gait::Static)
+        );
         let without = PostProcessParams::from_config_for(
             &ConfigFile::parse(SECTION, path).unwrap(),
             Gait::Dynamic,
         )
         .unwrap();
-        assert_eq!(without, fixed);
+        assert_eq!(
+            without,
+            PostProcessParams {
+                gait: Gait::Dynamic,
+                ..fixed
+            }
+        );
     }
 
     #[test]

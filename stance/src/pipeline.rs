@@ -83,6 +83,7 @@ impl<'r> PostProcessor<'r> {
         self.forward_kinematics(raw)?;
         run_passes(&mut self.poses, raw.environment(), &self.params);
         out.assign(raw, &self.poses);
+        out.gait = Some(self.params.gait);
         Ok(())
     }
 
@@ -96,6 +97,7 @@ impl<'r> PostProcessor<'r> {
         run_passes_observed(&mut self.poses, raw.environment(), &self.params, after);
         let mut out = PostProcessedSequence::empty();
         out.assign(raw, &self.poses);
+        out.gait = Some(self.params.gait);
         Ok(out)
     }
 }

@@ -7,6 +7,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use crate::environment::Environment;
 use crate::error::{FormatError, Location};
+use crate::params::Gait;
 
 /// One stance `S = { q_S, c_S(lf), c_S(rf), c_S(lh), c_S(rh), t_S }`.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,6 +54,9 @@ pub struct RawSequence {
 pub struct PostProcessedSequence {
     pub(crate) sequence: StanceSequence,
     pub(crate) targets: Vec<[Isometry3<f64>; 4]>,
+    /// The gait whose limits post-processed it, and which walks it; `None` (a file that does
+    /// not say): the robot config's `[gait] default`.
+    pub(crate) gait: Option<Gait>,
 }
 
 impl StanceSequence {
@@ -167,6 +171,7 @@ impl PostProcessedSequence {
         Ok(Self {
             sequence: StanceSequence::new(robot, joint_names, environment, stances)?,
             targets,
+            gait: None,
         })
     }
 
@@ -175,7 +180,20 @@ impl PostProcessedSequence {
         Self {
             sequence: StanceSequence::default(),
             targets: Vec::new(),
+            gait: None,
         }
+    }
+
+    /// The gait the sequence asks to be walked with (`None`: the robot's default).
+    pub fn gait(&self) -> Option<Gait> {
+        self.gait
+    }
+
+    /// The sequence asking for `gait` (`None`: the robot's default), e.g. a client's
+    /// `--gait` choice for a file post-processed earlier.
+    pub fn with_gait(mut self, gait: Option<Gait>) -> Self {
+        self.gait = gait;
+        self
     }
 
     /// Contact flags of stance `i`, indexed by [`EndEffector`]. Panics if `i >= len()`.

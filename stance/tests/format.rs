@@ -5,8 +5,8 @@ mod common;
 
 use serde_json::{Value, json};
 use stance::{
-    AffordanceSet, FormatError, GenerateOptions, Location, PostProcessedSequence, PostProcessor,
-    RawSequence, generate,
+    AffordanceSet, FormatError, Gait, GenerateOptions, Location, PostProcessParams,
+    PostProcessedSequence, PostProcessor, RawSequence, generate,
 };
 
 fn raw() -> RawSequence {
@@ -243,5 +243,39 @@ fn post_processed_target_nan_is_refused() {
         FormatError::NonFinite {
             location: Location::stance(2, "targets.left_hand.translation[1]")
         }
+    );
+}
+
+#[test]
+fn a_post_processed_file_carries_the_gait_it_was_post_processed_for() {
+    let (robot, params) = common::jvrc1();
+    let statically = processed();
+    assert_eq!(statically.gait(), Some(Gait::Static));
+    let dynamic_params = PostProcessParams {
+        gait: Gait::Dynamic,
+        ..params.clone()
+    };
+    let dynamically = PostProcessor::new(robot, dynamic_params)
+        .process(&raw())
+        .unwrap();
+    let text = dynamically.to_json_string();
+    let value: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(value["gait"], json!("dynamic"));
+    let back = PostProcessedSequence::from_json_str(&text, robot).unwrap();
+    assert_eq!(back.gait(), Some(Gait::Dynamic));
+    // A file that does not say leaves the choice to the robot's config.
+    let mut value = value;
+    value.as_object_mut().unwrap().remove("gait");
+    let unsaid = PostProcessedSequence::from_json_str(&value.to_string(), robot).unwrap();
+    assert_eq!(unsaid.gait(), None);
+    assert!(!unsaid.to_json_string().contains("\"gait\""));
+    // An unknown gait is named; a raw file has none.
+    value["gait"] = json!("running");
+    let err = PostProcessedSequence::from_json_str(&value.to_string(), robot).unwrap_err();
+    assert!(err.to_string().contains("running"), "{err}");
+    let err = read_edited(|raw| raw["gait"] = json!("dynamic")).unwrap_err();
+    assert!(
+        err.to_string().contains("`gait`") && err.to_string().contains("post-processed"),
+        "{err}"
     );
 }

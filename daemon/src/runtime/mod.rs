@@ -39,9 +39,9 @@ use shm_types::{
     ClockMode, DaemonLoopPorts, DaemonServicePorts, DaemonStatus, RuntimeConfig, ServiceNames,
 };
 
-use crate::controller::{Controller, ControllerConfig, SolverKind};
+use crate::controller::{Controller, ControllerConfig, GaitConfig, SolverKind};
 use control_loop::{ControlLoop, LoopTiming};
-use service::{ServiceLoop, SubmissionLimits};
+use service::{Acceptance, ServiceLoop, SubmissionLimits};
 use shared::Shared;
 
 /// Command line of the daemon (flattened into `walkd`'s top level).
@@ -111,6 +111,7 @@ struct Setup {
     runtime: RuntimeConfig,
     robot: Arc<Robot>,
     controller_config: ControllerConfig,
+    gaits: GaitConfig,
 }
 
 fn load(args: &DaemonArgs) -> Result<Setup, Failure> {
@@ -148,10 +149,12 @@ fn load(args: &DaemonArgs) -> Result<Setup, Failure> {
         .map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
     let controller_config =
         ControllerConfig::from_config(&file).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
+    let gaits = GaitConfig::from_config(&file).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
     Ok(Setup {
         runtime,
         robot: Arc::new(robot),
         controller_config,
+        gaits,
     })
 }
 
@@ -160,6 +163,7 @@ fn run(args: &DaemonArgs) -> Result<(), Failure> {
         runtime,
         robot,
         controller_config,
+        gaits,
     } = load(args)?;
     let controller = Controller::new(Arc::clone(&robot), controller_config, SolverKind::Dense)
         .map_err(|e| fail(exit_code::CONTROLLER)(e.into()))?;
@@ -193,11 +197,14 @@ fn run(args: &DaemonArgs) -> Result<(), Failure> {
         ports,
         Arc::clone(&shared),
         status_in,
-        robot,
-        controller_config,
-        SubmissionLimits {
-            max_bytes: runtime.max_submission_bytes,
-            max_stances: runtime.max_stances,
+        Acceptance {
+            robot,
+            config: controller_config,
+            gaits,
+            limits: SubmissionLimits {
+                max_bytes: runtime.max_submission_bytes,
+                max_stances: runtime.max_stances,
+            },
         },
         runtime.status_rate_hz,
     );

@@ -20,7 +20,21 @@ use shm_types::{
 use super::realtime::release_free_memory;
 use super::shared::{ControlOutcome, Shared, StartOutcome, Submission};
 use super::snapshot::SnapshotReader;
-use crate::controller::{Controller, ControllerConfig};
+use crate::controller::{Controller, ControllerConfig, GaitConfig};
+
+/// What a submitted sequence is checked and prepared against: the robot and its config.
+#[derive(Debug, Clone)]
+pub struct Acceptance {
+    /// The robot the daemon controls.
+    pub robot: Arc<Robot>,
+    /// `[controller]`.
+    pub config: ControllerConfig,
+    /// `[gait]`: the gait of a sequence that does not name one, and whether the dynamic gait
+    /// is available.
+    pub gaits: GaitConfig,
+    /// `[runtime]` size bounds.
+    pub limits: SubmissionLimits,
+}
 
 /// How large a submission walkd reads (`[runtime]` keys).
 #[derive(Debug, Clone, Copy)]
@@ -51,9 +65,7 @@ pub struct ServiceLoop {
 struct Requests {
     shared: Arc<Shared>,
     status_in: SnapshotReader<DaemonStatus>,
-    robot: Arc<Robot>,
-    config: ControllerConfig,
-    limits: SubmissionLimits,
+    acceptance: Acceptance,
     next_sequence_id: u64,
     next_ticket: u64,
 }
@@ -64,9 +76,7 @@ impl ServiceLoop {
         ports: DaemonServicePorts,
         shared: Arc<Shared>,
         status_in: SnapshotReader<DaemonStatus>,
-        robot: Arc<Robot>,
-        config: ControllerConfig,
-        limits: SubmissionLimits,
+        acceptance: Acceptance,
         status_rate_hz: f64,
     ) -> Self {
         Self {
@@ -74,9 +84,7 @@ impl ServiceLoop {
             requests: Requests {
                 shared,
                 status_in,
-                robot,
-                config,
-                limits,
+                acceptance,
                 next_sequence_id: 1,
                 next_ticket: 1,
             },
@@ -178,7 +186,7 @@ impl Requests {
     }
 
     fn try_submit(&mut self, json: &[u8]) -> Result<u64, String> {
-        let limits = self.limits;
+        let limits = self.acceptance.limits;
         if json.len() > limits.max_bytes {
             return Err(format!(
                 "the submission has {} bytes, more than [runtime] max_submission_bytes = {}",
@@ -203,10 +211,18 @@ impl Requests {
                 limits.max_stances
             ));
         }
-        let prepared = stance::PostProcessedSequence::from_json_str(text, &self.robot)
+        let Acceptance {
+            robot,
+            config,
+            gaits,
+            ..
+        } = &self.acceptance;
+        let prepared = stance::PostProcessedSequence::from_json_str(text, robot)
             .map_err(|e| format!("invalid sequence: {e}"))
             .and_then(|sequence| {
-                Controller::prepare(&self.robot, &self.config, &sequence).map_err(|e| e.to_string())
+                let gait = sequence.gait().unwrap_or(gaits.default);
+                Controller::prepare_gait(robot, config, gaits, &sequence, gait)
+                    .map_err(|e| format!("{} gait: {e}", gait.name()))
             });
         // Parsing a large file leaves freed memory behind: hand it back now.
         release_free_memory();

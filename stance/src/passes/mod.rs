@@ -195,6 +195,7 @@ mod tests {
             h_min: 0.03,
             h_max: 0.1,
             contact_unification: ContactUnification::First,
+            gait: crate::Gait::Static,
         }
     }
 

@@ -184,7 +184,7 @@ impl GaitConfig {
     /// The dynamic gait's tuning, or why a dynamic walk cannot be executed on this robot.
     pub fn dynamic(&self) -> Result<&DynamicGaitConfig, String> {
         self.dynamic.as_ref().ok_or_else(|| {
-            "the dynamic gait needs a [gait.dynamic] section in the robot config".to_owned()
+            "the robot config has no [gait.dynamic] section, so this robot walks statically only".to_owned()
         })
     }
 
