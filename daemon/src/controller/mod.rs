@@ -34,6 +34,7 @@ mod machine;
 mod plan;
 mod sequence;
 mod status;
+mod telemetry;
 mod trajectory;
 
 use std::sync::Arc;
@@ -48,6 +49,7 @@ pub use sequence::{PreparedSequence, Refusal};
 pub use status::{
     ControllerState, ControllerStatus, FaultCode, FaultDescription, MeasurementFault, Phase,
 };
+pub use telemetry::{BalanceTelemetry, ControllerTelemetry};
 
 use assembly::QpAssembler;
 use estimator::BaseEstimator;
