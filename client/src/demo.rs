@@ -18,6 +18,7 @@ use shm_types::{ClockMode, DaemonState, DaemonStatus, LatencySummary, RuntimeCon
 use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
 use crate::evaluate::process::{Process, connect_when_fresh};
 use crate::evaluate::truth::{TruthRecorder, Verdict, judged_outcome};
+use crate::observe::{Recorder, RecorderOutcome};
 use crate::watch::StanceProgress;
 
 /// The robots with a vendored config.
@@ -94,6 +95,9 @@ pub struct DemoArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Record the walk (an observer beside walkd) to `DIR/demo-<robot>.mcap`.
+    #[arg(long, value_name = "DIR")]
+    pub record: Option<PathBuf>,
 }
 
 /// What the demo measured.
@@ -114,6 +118,8 @@ pub struct DemoOutcome {
     /// Largest tilt of the simulated `base_link` since submission (rad); `None` when no
     /// simulator published its truth (e.g. a running walkd driving a real robot).
     pub max_tilt_rad: Option<f64>,
+    /// The recording, with `--record`.
+    pub recording: Option<RecorderOutcome>,
 }
 
 impl DemoOutcome {
@@ -151,6 +157,12 @@ impl DemoOutcome {
             "latency_us": tick(&self.status.latency_us),
             "clock": self.status.clock.name(),
             "rate_hz": self.status.rate_hz,
+            "recording": self.recording.as_ref().map(|r| serde_json::json!({
+                "file": r.summary.path,
+                "messages": r.summary.messages,
+                "bytes": r.summary.bytes,
+                "observer": r.report.json(),
+            })),
         })
     }
 }
@@ -234,7 +246,7 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         .service_prefix
         .clone()
         .unwrap_or(runtime.service_prefix);
-    let robot = Robot::from_config(&file, args.urdf.as_deref())?;
+    let robot = std::sync::Arc::new(Robot::from_config(&file, args.urdf.as_deref())?);
     let (json, stance_count) = walk_sequence(&robot, &config, args.distance, args.seed)?;
 
     let mut children = Children(Vec::new());
@@ -261,6 +273,14 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     }
     let processes: Vec<&Process> = children.0.iter().collect();
     let client = connect_when_fresh(&prefix, &processes, Duration::from_secs(20))?;
+    let observer = args
+        .record
+        .as_ref()
+        .map(|dir| {
+            let file = dir.join(format!("demo-{}.mcap", args.robot.name()));
+            Recorder::start(&prefix, std::sync::Arc::clone(&robot), &file)
+        })
+        .transpose()?;
     let recorder = TruthRecorder::start(&prefix)?;
     let start = client.status()?;
     let wall = Instant::now();
@@ -280,6 +300,7 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     // Let a final status with the complete tick statistics arrive.
     let status = client.status().unwrap_or(last);
     drop(client);
+    let recording = observer.map(Recorder::finish).transpose()?;
     let verdict = Verdict::of(&recorder.finish()?, submitted_ns);
     let problems = children.shut_down()?;
     if !problems.is_empty() {
@@ -297,6 +318,7 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         wall_s,
         fell_at_s: verdict.and_then(|v| v.fell_at_s),
         max_tilt_rad: verdict.map(|v| v.max_tilt_rad),
+        recording,
         status,
     })
 }
@@ -323,6 +345,16 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
             outcome.sim_s / outcome.wall_s,
             status_text(&outcome.status)
         );
+        if let Some(recording) = &outcome.recording {
+            println!(
+                "recorded {} messages to {} (observer lost {} telemetry, {} samples, {} commands)",
+                recording.summary.messages,
+                recording.summary.path.display(),
+                recording.report.telemetry.lost,
+                recording.report.samples.lost,
+                recording.report.commands.lost
+            );
+        }
     }
     if !outcome.succeeded() {
         bail!("the walk did not complete: {}", outcome.outcome());

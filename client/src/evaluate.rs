@@ -87,6 +87,10 @@ pub struct EvaluateArgs {
     /// Write Fig. 6 per robot (`fig6_<robot>.svg`) into this directory.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
+    /// Record every run (an observer beside walkd) to
+    /// `DIR/<robot>-<affordances>-<distance>m-run<run>.mcap`.
+    #[arg(long, value_name = "DIR")]
+    pub record: Option<PathBuf>,
 }
 
 /// The CoM and both soles' positions in the world (m).
@@ -363,6 +367,17 @@ fn run_once(
     sim_args.extend(["--physics".into(), args.physics.name().into()]);
     let sim = Process::start("walk-sim", &sim_args)?;
     let client = connect_when_fresh(&prefix, &[&walkd, &sim], Duration::from_secs(30))?;
+    let observer = args
+        .record
+        .as_ref()
+        .map(|dir| {
+            let file = dir.join(format!(
+                "{robot}-{}-{distance}m-run{run}.mcap",
+                affordances.name()
+            ));
+            crate::observe::Recorder::start(&prefix, std::sync::Arc::new(model.clone()), &file)
+        })
+        .transpose()?;
     let recorder = truth::TruthRecorder::start(&prefix)?;
     let start = client.status()?;
     align_targets(
@@ -384,6 +399,9 @@ fn run_once(
     })?;
     let wall_s = wall.elapsed().as_secs_f64();
     drop(client);
+    if let Some(observer) = observer {
+        observer.finish()?;
+    }
     let states = recorder.finish()?;
     let walkd_log = walkd.stop()?.log;
     let sim_log = sim.stop()?.log;
