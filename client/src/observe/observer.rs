@@ -18,7 +18,7 @@ use super::channels::{Channels, Clock};
 use super::description::description_urdf;
 use super::links::LinkPoser;
 use super::report::ObserverReport;
-use super::source::{Batch, Source};
+use super::source::{Batch, Source, yield_to_the_controller};
 
 /// How often the robot description is logged again, so a viewer that connects (or seeks) later
 /// still gets it.
@@ -43,7 +43,10 @@ impl Observer {
         let poser = LinkPoser::new(robot);
         let worker = std::thread::Builder::new()
             .name("observer-log".to_owned())
-            .spawn(move || Logger::new(channels, poser, description).run(&batches))
+            .spawn(move || {
+                yield_to_the_controller();
+                Logger::new(channels, poser, description).run(&batches)
+            })
             .context("starting the observer's logging thread")?;
         Ok(Self { source, worker })
     }

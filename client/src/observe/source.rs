@@ -13,6 +13,19 @@ use shm_types::{
     DaemonStatus, JointCommand, Observed, ObserverPorts, SensorSample, ServiceNames, Telemetry,
 };
 
+/// Nice value of the observer's threads: an observer yields the CPU to walkd and its adapter.
+pub const OBSERVER_NICE: i32 = 10;
+
+/// Lowers the calling thread's scheduling priority to [`OBSERVER_NICE`] (best effort: on Linux
+/// the nice value is per thread).
+pub fn yield_to_the_controller() {
+    // SAFETY: setpriority has no memory-safety preconditions; PRIO_PROCESS with who = 0 is the
+    // calling thread on Linux.
+    unsafe {
+        libc::setpriority(libc::PRIO_PROCESS, 0, OBSERVER_NICE);
+    }
+}
+
 /// How often the streams are drained: well inside their buffers (128 stream messages and 256
 /// telemetries, over 100 ms at 1 kHz).
 pub const POLL: Duration = Duration::from_millis(1);
@@ -58,6 +71,7 @@ impl Source {
         let handle = std::thread::Builder::new()
             .name("observer-poll".to_owned())
             .spawn(move || {
+                yield_to_the_controller();
                 // iceoryx2 ports stay on the thread that created them.
                 let ports = match ObserverPorts::open(&names, "walkctl-observer") {
                     Ok(ports) => {
