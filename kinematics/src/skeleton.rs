@@ -9,9 +9,10 @@
 //! - a capsule from a link's origin to the origin of each child link, when both weigh more than
 //!   [`MIN_LINK_MASS`] (so massless helper links — sensor mounts, a root link on the floor — draw
 //!   nothing) and the segment is at least [`MIN_SEGMENT`] long;
-//! - a sphere at the centre of mass of a link of at least [`HEAD_MASS`] that draws no segment to a
-//!   child (a head at the end of the neck);
-//! - a box per foot: the configured sole rectangle (`[robot] sole`), [`SOLE_THICKNESS`] high,
+//! - a sphere at the centre of mass of a link of at least [`HEAD_MASS`] without a child heavier
+//!   than [`MIN_LINK_MASS`] and without an end-effector frame (a head at the end of the neck);
+//! - a capsule from each foot link's origin (the ankle) to its sole frame, and a box per foot: the
+//!   configured sole rectangle (`[robot] sole`), [`SOLE_THICKNESS`] high,
 //!   its bottom face on the sole frame;
 //! - a sphere per hand at the palm frame.
 
@@ -90,14 +91,20 @@ pub fn skeleton(robot: &Robot) -> Vec<LinkShape> {
     let model = &robot.model;
     let heavy = |link: LinkId| model.link_mass(link) > MIN_LINK_MASS;
     let mut shapes = Vec::new();
-    let mut draws_child = vec![false; model.link_count()];
+    // Links that end a chain of heavy links and carry no end-effector: heads.
+    let mut leaf = vec![true; model.link_count()];
+    for effector in EndEffector::ALL {
+        leaf[model.frame_link(robot.frame(effector)).index()] = false;
+    }
     for child in model.link_ids() {
         let Some(parent) = model.link_parent(child) else {
             continue;
         };
+        if heavy(child) {
+            leaf[parent.index()] = false;
+        }
         let to = model.link_origin(child).translation.vector;
         if heavy(parent) && heavy(child) && to.norm() >= MIN_SEGMENT {
-            draws_child[parent.index()] = true;
             shapes.push(LinkShape {
                 link: parent,
                 shape: Shape::Capsule {
@@ -110,7 +117,7 @@ pub fn skeleton(robot: &Robot) -> Vec<LinkShape> {
         }
     }
     for link in model.link_ids() {
-        if !draws_child[link.index()] && model.link_mass(link) >= HEAD_MASS {
+        if leaf[link.index()] && model.link_mass(link) >= HEAD_MASS {
             shapes.push(LinkShape {
                 link,
                 shape: Shape::Sphere {
@@ -125,6 +132,18 @@ pub fn skeleton(robot: &Robot) -> Vec<LinkShape> {
         let frame = robot.frame(effector);
         let link = model.frame_link(frame);
         let offset = model.frame_offset(frame);
+        if effector.is_foot() && offset.translation.vector.norm() >= MIN_SEGMENT {
+            // The ankle down to the sole.
+            shapes.push(LinkShape {
+                link,
+                shape: Shape::Capsule {
+                    from: Vector3::zeros(),
+                    to: offset.translation.vector,
+                    radius: LIMB_RADIUS,
+                },
+                part: Part::Limb,
+            });
+        }
         let (shape, part) = if effector.is_foot() {
             let half = Vector3::new(robot.sole.length, robot.sole.width, SOLE_THICKNESS) / 2.0;
             let shape = Shape::Box {

@@ -15,8 +15,11 @@ mod contact;
 mod error;
 mod mjcf;
 mod options;
+#[cfg(feature = "render")]
+pub mod render;
 mod robot_io;
 mod sim;
+mod visuals;
 
 pub use error::MujocoError;
 pub use options::MujocoOptions;

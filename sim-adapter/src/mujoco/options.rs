@@ -34,6 +34,10 @@ pub struct MujocoOptions {
     pub fall_height_fraction: f64,
     /// ... or when the base link's z axis tilts more than this from vertical (rad).
     pub fall_tilt: f64,
+    /// Give the model what its pictures need (`mjcf`): visual-only geoms drawing the links
+    /// (`kinematics::skeleton`), a floor texture, a sky and an offscreen buffer. They take part in
+    /// no collision and no inertia, so the dynamics are bit-identical either way (tested).
+    pub visual_geoms: bool,
 }
 
 impl Default for MujocoOptions {
@@ -49,6 +53,7 @@ impl Default for MujocoOptions {
             contact_time_constant: 0.005,
             fall_height_fraction: 0.7,
             fall_tilt: 0.6,
+            visual_geoms: true,
         }
     }
 }

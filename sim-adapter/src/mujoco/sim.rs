@@ -137,6 +137,17 @@ impl MujocoSim {
         &self.options
     }
 
+    /// The compiled MuJoCo model (e.g. to count its geoms or build a renderer for it).
+    pub fn model(&self) -> &MjModel {
+        self.data.model()
+    }
+
+    /// The MuJoCo state, for the renderer (which reads the model and the current state).
+    #[cfg(feature = "render")]
+    pub(crate) fn data_mut(&mut self) -> &mut MjData<Box<MjModel>> {
+        &mut self.data
+    }
+
     /// Simulated time since the start (s).
     pub fn time(&self) -> f64 {
         self.data.time()
