@@ -15,6 +15,7 @@
 //! only): target vs controller state vs simulator over time for the CoM and both feet
 //! ([`write_fig6`] is shared with the in-process physics walk of the `walk-tests` package).
 
+pub mod filmstrip;
 pub(crate) mod process;
 pub(crate) mod truth;
 
@@ -87,6 +88,12 @@ pub struct EvaluateArgs {
     /// Write Fig. 6 per robot (`fig6_<robot>.svg`) into this directory.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
+    /// Pictures of the walk (MuJoCo's offscreen renderer in walk-sim, built with --features
+    /// sim-adapter/render): per robot, of its first run of the first distance and affordance set,
+    /// a side view every 0.5 s of simulated time in `DIR/frames-<robot>/` and the filmstrip
+    /// `DIR/filmstrip-<robot>.png` (the paper's Fig. 5).
+    #[arg(long, value_name = "DIR")]
+    pub snapshots: Option<PathBuf>,
     /// Record every run (an observer beside walkd) to
     /// `DIR/<robot>-<affordances>-<distance>m-run<run>.mcap`.
     #[arg(long, value_name = "DIR")]
@@ -365,6 +372,17 @@ fn run_once(
     let walkd = Process::start("walkd", &walkd_args)?;
     let mut sim_args = common;
     sim_args.extend(["--physics".into(), args.physics.name().into()]);
+    let pictured = args.snapshots.as_ref().filter(|_| {
+        run == 0 && distance == args.distances[0] && affordances == args.affordances[0]
+    });
+    let frames = pictured.map(|dir| dir.join(format!("frames-{robot}")));
+    if let Some(frames) = &frames {
+        let _ = std::fs::remove_dir_all(frames);
+        // The side camera looks at the middle of the walk (it starts at x = 0 along +x).
+        let lookat = format!("{},0,0.8", distance / 2.0);
+        sim_args.extend(["--snapshots".into(), frames.into()]);
+        sim_args.extend(["--snapshot-lookat".into(), lookat.into()]);
+    }
     let sim = Process::start("walk-sim", &sim_args)?;
     let client = connect_when_fresh(&prefix, &[&walkd, &sim], Duration::from_secs(30))?;
     let observer = args
@@ -411,6 +429,22 @@ fn run_once(
              walk-sim's log:\n{sim_log}\nwalkd's log:\n{walkd_log}"
         );
     };
+    if let (Some(dir), Some(frames)) = (pictured, &frames) {
+        let start = truth::state_at(&states, submitted_ns).map_or(0.0, |s| s.sim_time_s);
+        let end = truth::state_at(&states, last.timestamp_ns)
+            .map_or(verdict.end.sim_time_s, |s| s.sim_time_s);
+        let strip = dir.join(format!("filmstrip-{robot}.png"));
+        let times = filmstrip::write_filmstrip(frames, start, end, &strip)?;
+        eprintln!(
+            "{}: {robot} at {} s of simulated time",
+            strip.display(),
+            times
+                .iter()
+                .map(|t| format!("{:.1}", t - start))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     let drift = pair_with_truth(&mut trace, &status_times, &states);
     let end = Points::from_truth(&verdict.end);
     let final_target = targets[targets.len() - 1];

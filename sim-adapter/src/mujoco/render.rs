@@ -15,7 +15,10 @@ use mujoco_rs::prelude::MjtCamera;
 use mujoco_rs::renderer::MjRenderer;
 use mujoco_rs::wrappers::mj_visualization::MjvCamera;
 
-use super::{MujocoError, MujocoSim};
+use shm_types::{SensorSample, SimTruth};
+
+use super::{MujocoError, MujocoRobot, MujocoSim};
+use crate::{GroundTruth, RobotIo};
 
 /// Where and how pictures are taken.
 #[derive(Debug, Clone, PartialEq)]
@@ -132,6 +135,55 @@ impl Snapshots {
         write_png(path, rgb, self.options.width, self.options.height)?;
         self.saved += 1;
         Ok(())
+    }
+}
+
+/// A MuJoCo robot that takes a picture every `period_s` of simulated time while it is driven
+/// (`walk-sim --snapshots`); otherwise the same robot.
+pub struct SnapshotRobot {
+    robot: MujocoRobot,
+    snapshots: Snapshots,
+}
+
+impl SnapshotRobot {
+    /// `robot`, photographed as `options` say (fails if the renderer cannot start).
+    pub fn new(mut robot: MujocoRobot, options: SnapshotOptions) -> Result<Self, MujocoError> {
+        let mut snapshots = Snapshots::new(robot.sim(), options)?;
+        snapshots.capture_due(robot.sim_mut())?;
+        Ok(Self { robot, snapshots })
+    }
+
+    /// The robot photographed.
+    pub fn robot(&self) -> &MujocoRobot {
+        &self.robot
+    }
+
+    /// Pictures saved so far.
+    pub fn saved(&self) -> usize {
+        self.snapshots.saved()
+    }
+}
+
+impl RobotIo for SnapshotRobot {
+    type Error = MujocoError;
+
+    fn joint_count(&self) -> usize {
+        self.robot.joint_count()
+    }
+
+    fn read(&mut self, sample: &mut SensorSample) {
+        self.robot.read(sample);
+    }
+
+    fn write(&mut self, q_des: &[f64], qd_des: &[f64], dt: f64) -> Result<(), MujocoError> {
+        self.robot.write(q_des, qd_des, dt)?;
+        self.snapshots.capture_due(self.robot.sim_mut())
+    }
+}
+
+impl GroundTruth for SnapshotRobot {
+    fn ground_truth(&mut self, out: &mut SimTruth) {
+        self.robot.ground_truth(out);
     }
 }
 

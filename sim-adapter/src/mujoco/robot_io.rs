@@ -37,6 +37,12 @@ impl MujocoRobot {
         &self.sim
     }
 
+    /// The simulator, for the renderer.
+    #[cfg(feature = "render")]
+    pub(crate) fn sim_mut(&mut self) -> &mut MujocoSim {
+        &mut self.sim
+    }
+
     /// Worst safety values since the start (stability margin, slip, falls).
     pub fn summary(&self) -> &SafetySummary {
         self.sim.summary()
