@@ -17,6 +17,6 @@ eval "$mujoco_env"
 scripts/setup-observe.sh --python \
     || echo "test.sh: continuing; the tests that need what is missing fail and name it" >&2
 
-cargo build --release --workspace --bins --features sim-adapter/mujoco
+cargo build --release --workspace --bins --features sim-adapter/mujoco,sim-adapter/render
 # walk-tests/mujoco: the in-process physics walk (tests/physics_walk.rs fails if it is off).
-cargo test --release --workspace --features sim-adapter/mujoco,walk-tests/mujoco "$@"
+cargo test --release --workspace --features sim-adapter/mujoco,sim-adapter/render,walk-tests/mujoco "$@"

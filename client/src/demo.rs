@@ -98,6 +98,10 @@ pub struct DemoArgs {
     /// Record the walk (an observer beside walkd) to `DIR/demo-<robot>.mcap`.
     #[arg(long, value_name = "DIR")]
     pub record: Option<PathBuf>,
+    /// Write the walk's Fig. 6 (target, controller and simulator for the CoM and both feet) to
+    /// `DIR/fig6-<robot>.svg`.
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
 }
 
 /// What the demo measured.
@@ -120,6 +124,8 @@ pub struct DemoOutcome {
     pub max_tilt_rad: Option<f64>,
     /// The recording, with `--record`.
     pub recording: Option<RecorderOutcome>,
+    /// The Fig. 6 plot, with `--plots`.
+    pub plot: Option<PathBuf>,
 }
 
 impl DemoOutcome {
@@ -157,6 +163,7 @@ impl DemoOutcome {
             "latency_us": tick(&self.status.latency_us),
             "clock": self.status.clock.name(),
             "rate_hz": self.status.rate_hz,
+            "plot": self.plot,
             "recording": self.recording.as_ref().map(|r| serde_json::json!({
                 "file": r.summary.path,
                 "messages": r.summary.messages,
@@ -221,6 +228,17 @@ pub fn walk_sequence(
     distance: f64,
     seed: u64,
 ) -> anyhow::Result<(String, usize)> {
+    let processed = walk(robot, config, distance, seed)?;
+    Ok((processed.to_json_string(), processed.len()))
+}
+
+/// Generates and post-processes a forward walk of `distance` for `robot` (config `config`).
+fn walk(
+    robot: &Robot,
+    config: &Path,
+    distance: f64,
+    seed: u64,
+) -> anyhow::Result<stance::PostProcessedSequence> {
     let params = stance::PostProcessParams::from_config_path(config)?;
     let raw = stance::generate(
         robot,
@@ -230,8 +248,7 @@ pub fn walk_sequence(
             seed,
         },
     )?;
-    let processed = stance::PostProcessor::new(robot, params).process(&raw)?;
-    Ok((processed.to_json_string(), processed.len()))
+    Ok(stance::PostProcessor::new(robot, params).process(&raw)?)
 }
 
 /// Runs the demo and returns what it measured (also used by the e2e tests).
@@ -247,7 +264,9 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         .clone()
         .unwrap_or(runtime.service_prefix);
     let robot = std::sync::Arc::new(Robot::from_config(&file, args.urdf.as_deref())?);
-    let (json, stance_count) = walk_sequence(&robot, &config, args.distance, args.seed)?;
+    let sequence = walk(&robot, &config, args.distance, args.seed)?;
+    let (json, stance_count) = (sequence.to_json_string(), sequence.len());
+    let mut targets = crate::evaluate::stance_points(&robot, &sequence);
 
     let mut children = Children(Vec::new());
     let running = DaemonClient::connect(&prefix).is_ok_and(|client| client.is_running());
@@ -283,14 +302,27 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         .transpose()?;
     let recorder = TruthRecorder::start(&prefix)?;
     let start = client.status()?;
+    crate::evaluate::align_targets(
+        &mut targets,
+        &sequence,
+        &[
+            crate::evaluate::pose_of(&start.left_foot),
+            crate::evaluate::pose_of(&start.right_foot),
+        ],
+    );
     let wall = Instant::now();
     let submitted_ns = shm_types::monotonic_ns();
     let id = client.submit_json(&json)?;
     let progress = (!args.json).then(StanceProgress::new);
     let timeout = Duration::from_secs(60 + 30 * stance_count as u64);
+    let (mut trace, mut status_times) = (Vec::new(), Vec::new());
     let last = client.wait_for_sequence(id, timeout, |status| {
         if let Some(progress) = &progress {
             progress.update(status);
+        }
+        if args.plots.is_some() && status.sequence_id == id {
+            trace.push(crate::evaluate::sample(status, &start, &targets));
+            status_times.push(status.timestamp_ns);
         }
     })?;
     if let Some(progress) = &progress {
@@ -301,7 +333,24 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     let status = client.status().unwrap_or(last);
     drop(client);
     let recording = observer.map(Recorder::finish).transpose()?;
-    let verdict = Verdict::of(&recorder.finish()?, submitted_ns);
+    let states = recorder.finish()?;
+    let verdict = Verdict::of(&states, submitted_ns);
+    let plot = match &args.plots {
+        Some(dir) => {
+            crate::evaluate::pair_with_truth(&mut trace, &status_times, &states);
+            std::fs::create_dir_all(dir)?;
+            let file = dir.join(format!("fig6-{}.svg", args.robot.name()));
+            let title = format!(
+                "{}, {} m, walkctl demo --physics {}",
+                args.robot.name(),
+                args.distance,
+                args.physics.name()
+            );
+            crate::evaluate::write_fig6(&file, &title, &trace)?;
+            Some(file)
+        }
+        None => None,
+    };
     let problems = children.shut_down()?;
     if !problems.is_empty() {
         bail!("shutting down: {}", problems.join("; "));
@@ -319,6 +368,7 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         fell_at_s: verdict.and_then(|v| v.fell_at_s),
         max_tilt_rad: verdict.map(|v| v.max_tilt_rad),
         recording,
+        plot,
         status,
     })
 }
@@ -347,12 +397,24 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         );
         if let Some(recording) = &outcome.recording {
             println!(
-                "recorded {} messages to {} (observer lost {} telemetry, {} samples, {} commands)",
-                recording.summary.messages,
+                "recording: {} ({} messages, {:.1} MB; the observer lost {} telemetries, {} \
+                 samples, {} commands)\n  open it in Foxglove (Open local file; docs/observe.md \
+                 lists the channels), or read it with `python3 tests/python/check_recording.py \
+                 {} docs/observe.md`",
                 recording.summary.path.display(),
+                recording.summary.messages,
+                recording.summary.bytes as f64 / 1e6,
                 recording.report.telemetry.lost,
                 recording.report.samples.lost,
-                recording.report.commands.lost
+                recording.report.commands.lost,
+                recording.summary.path.display()
+            );
+        }
+        if let Some(plot) = &outcome.plot {
+            println!(
+                "plot: {} (Fig. 6: target, controller and simulator of the CoM and both feet; \
+                 open it in a web browser)",
+                plot.display()
             );
         }
     }

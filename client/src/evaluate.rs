@@ -189,7 +189,7 @@ pub fn align_targets(
 }
 
 /// The pose a status carries as `[x, y, z, qx, qy, qz, qw]`.
-fn pose_of(pose: &[f64; 7]) -> Isometry3<f64> {
+pub(crate) fn pose_of(pose: &[f64; 7]) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(pose[0], pose[1], pose[2]),
         UnitQuaternion::from_quaternion(Quaternion::new(pose[6], pose[3], pose[4], pose[5])),
@@ -474,7 +474,11 @@ fn run_once(
     })
 }
 
-fn sample(status: &DaemonStatus, start: &DaemonStatus, targets: &[Points]) -> TraceSample {
+pub(crate) fn sample(
+    status: &DaemonStatus,
+    start: &DaemonStatus,
+    targets: &[Points],
+) -> TraceSample {
     let index = (status.stance_index as usize).min(targets.len() - 1);
     TraceSample {
         t: (status.ticks.saturating_sub(start.ticks)) as f64 / status.rate_hz,
@@ -488,7 +492,7 @@ fn sample(status: &DaemonStatus, start: &DaemonStatus, targets: &[Points]) -> Tr
 /// Puts the simulator's state into every trace sample whose status (written at `status_times`)
 /// pairs with one; returns the largest controller-vs-simulator distance of the CoM or a sole
 /// and the number of paired samples, or `None` when none paired.
-fn pair_with_truth(
+pub(crate) fn pair_with_truth(
     trace: &mut [TraceSample],
     status_times: &[u64],
     states: &[SimTruth],

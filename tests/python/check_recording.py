@@ -5,8 +5,9 @@ Independent of the project's Rust code: the file is read with the PyPI packages 
 `mcap-protobuf-support` (protobuf messages decoded from the schemas stored in the file) and a
 JSON decoder; the channel list and rates come from the table in docs/observe.md.
 
-Usage: check_recording.py RECORDING.mcap docs/observe.md
-Prints one JSON object:
+Usage: check_recording.py RECORDING.mcap docs/observe.md [--strict]
+With --strict it exits with status 1 when a documented channel is missing or a sequence number
+is (the main job's check in .ci/run). Prints one JSON object:
   documented        topics the docs list; missing: documented topics absent from the file
   counts            messages per topic; expected: count the documented rate gives for the
                     walk's duration (span of the per-tick channel x rate); ratio = counts/expected
@@ -198,27 +199,27 @@ def main(recording, docs):
             worst_m = max(worst_m, math.dist(composed_t, position))
             worst_rad = max(worst_rad, angle_between(composed_q, orientation))
             pairs += 1
-    print(
-        json.dumps(
-            {
-                "documented": [t for t, _ in documented],
-                "missing": [t for t, _ in documented if t not in counts],
-                "counts": counts,
-                "expected": expected,
-                "ratio": ratios,
-                "rate_hz": rate_hz,
-                "duration_s": duration_s,
-                "ticks": len(ticks),
-                "transform": {"max_error_m": worst_m, "max_error_rad": worst_rad, "pairs": pairs},
-                "gaps": {k: gaps(v) for k, v in seqs.items()},
-                "received": {k: len(v) for k, v in seqs.items()},
-                "deadline_misses": deadline_misses,
-            }
-        )
-    )
+    report = {
+        "documented": [t for t, _ in documented],
+        "missing": [t for t, _ in documented if t not in counts],
+        "counts": counts,
+        "expected": expected,
+        "ratio": ratios,
+        "rate_hz": rate_hz,
+        "duration_s": duration_s,
+        "ticks": len(ticks),
+        "transform": {"max_error_m": worst_m, "max_error_rad": worst_rad, "pairs": pairs},
+        "gaps": {k: gaps(v) for k, v in seqs.items()},
+        "received": {k: len(v) for k, v in seqs.items()},
+        "deadline_misses": deadline_misses,
+    }
+    print(json.dumps(report))
+    return report
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    if len(sys.argv) not in (3, 4) or (len(sys.argv) == 4 and sys.argv[3] != "--strict"):
         sys.exit(__doc__)
-    main(sys.argv[1], sys.argv[2])
+    result = main(sys.argv[1], sys.argv[2])
+    if len(sys.argv) == 4 and (result["missing"] or any(result["gaps"].values())):
+        sys.exit(f"{sys.argv[1]}: missing channels {result['missing']}, gaps {result['gaps']}")

@@ -59,8 +59,15 @@ pub mod topic {
     pub const FAULTS: &str = "/faults";
 }
 
+const _: () = assert!(SCENE_DECIMATION % TF_DECIMATION == 0);
+
 /// The drawn `/scene/*` channels carry one message per this many ticks (50 Hz at 500 Hz).
 pub const SCENE_DECIMATION: u64 = 10;
+
+/// `/tf` carries one message per this many ticks (100 Hz at 500 Hz): enough for a viewer, which
+/// interpolates, at a fifth of the size (the joint angles themselves are on `/joint_states` at
+/// every sample).
+pub const TF_DECIMATION: u64 = 5;
 
 /// The JSON schema of `std_msgs/String`, the schema Foxglove's URDF layer reads a robot
 /// description from.
@@ -267,7 +274,7 @@ impl Channels {
         let t = self.clock.unix_ns(telemetry.sample_timestamp_ns);
         let stamp = timestamp(t);
         let base = isometry(&telemetry.base);
-        if let Some(sample) = sample {
+        if let Some(sample) = sample.filter(|_| telemetry.seq % TF_DECIMATION == 0) {
             let mut transforms = Vec::with_capacity(self.robot.model.link_count() + 6);
             poser.pose(sample.q(), &base, |edge| {
                 let p = pose(&edge.pose);
@@ -305,7 +312,8 @@ impl Channels {
             self.scene_targets
                 .log_with_time(&scene::targets(telemetry, &self.robot, stamp), t);
             if let Some(sample) = sample {
-                // The poser holds this sample's posture (posed for the transforms above).
+                // SCENE_DECIMATION is a multiple of TF_DECIMATION: the poser holds this sample's
+                // posture (posed for the transforms above).
                 let origins = self
                     .robot
                     .ft_sensors
