@@ -116,8 +116,9 @@ fn a_recorded_walk_reads_back_with_the_official_mcap_reader() {
     // The link transforms reproduce the controller's kinematics.
     let transform = &report["transform"];
     let ticks = report["ticks"].as_u64().unwrap();
+    // /tf comes with every 5th tick, four end-effectors each.
     assert!(
-        transform["pairs"].as_u64().unwrap() >= 4 * (ticks - 10),
+        transform["pairs"].as_u64().unwrap() >= 4 * (ticks / 5 - 10),
         "{report}"
     );
     assert!(
@@ -190,9 +191,12 @@ fn a_foxglove_websocket_client_sees_the_live_channels() {
         );
     }
     assert_eq!(channels["/tf"], "foxglove.FrameTransforms", "{watched}");
-    // About 500 transform messages per second arrive.
+    // About 100 transform messages per second arrive (/tf comes with every 5th tick).
     let messages = watched["messages"].as_u64().unwrap();
-    assert!(messages as f64 >= 0.5 * RATE_HZ * seconds, "{watched}");
+    assert!(
+        messages as f64 >= 0.5 * RATE_HZ / 5.0 * seconds,
+        "{watched}"
+    );
     let frames: Vec<&str> = watched["child_frames"]
         .as_array()
         .unwrap()
