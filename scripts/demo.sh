@@ -1,15 +1,24 @@
 #!/usr/bin/env bash
-# The project's main job (README): a walk, end to end, on the default robot.
+# The project's main job (README): a walk, end to end, on the default robot, under real physics.
 #
 # Sets up the pinned MuJoCo library, builds the binaries, then lets `walkctl demo` start `walkd`
-# and `walk-sim`, generate and post-process a stance sequence, submit it, watch it to the end and
-# shut everything down. Extra arguments go to `walkctl demo` (e.g. `--robot jvrc1 --distance 2
-# --json`, or `--physics mujoco`).
+# and `walk-sim --physics mujoco` in real time, generate and post-process a 1 m stance sequence for
+# ARMAR-4, submit it, watch it to the end, record it with an observer (MCAP) and plot it (Fig. 6),
+# and shut everything down. It ends by printing where the recording and the plot are and how to
+# open them. Extra arguments go to `walkctl demo` and win over these defaults (e.g.
+# `--physics kinematic`, `--robot jvrc1 --distance 2 --json`, `--record DIR`, `--plots DIR`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 mujoco_env="$(scripts/setup-mujoco.sh)"
 eval "$mujoco_env"
 
-cargo build --release --workspace --bins --features sim-adapter/mujoco
-exec target/release/walkctl demo "$@"
+cargo build --release --workspace --bins --features sim-adapter/mujoco,sim-adapter/render
+
+readonly OUT="target/demo"
+defaults=()
+has() { local flag="$1"; shift; for arg in "$@"; do [[ "$arg" == "$flag" || "$arg" == "$flag="* ]] && return 0; done; return 1; }
+has --physics "$@" || defaults+=(--physics mujoco)
+has --record "$@" || defaults+=(--record "$OUT")
+has --plots "$@" || defaults+=(--plots "$OUT")
+exec target/release/walkctl demo "${defaults[@]}" "$@"

@@ -14,11 +14,12 @@ use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::process::Physics;
 use shm_types::{ClockMode, DaemonState, DaemonStatus, LatencySummary, RuntimeConfig};
-use stance::WalkRequest;
+use stance::{Gait, WalkRequest};
 
 use crate::daemon_client::connect_when_fresh;
 use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
 use crate::evaluate::truth::{TruthRecorder, Verdict, judged_outcome};
+use crate::observe::{Recorder, RecorderOutcome};
 use crate::process::{Launch, Processes, executable_dir};
 use crate::watch::StanceProgress;
 
@@ -73,9 +74,20 @@ pub struct DemoArgs {
     /// Seed of the stance generator.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Gait: static or dynamic (default: the config's `[gait] default`). The walk is
+    /// post-processed with that gait's limits and asks walkd for it.
+    #[arg(long)]
+    pub gait: Option<Gait>,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Record the walk (an observer beside walkd) to `DIR/demo-<robot>.mcap`.
+    #[arg(long, value_name = "DIR")]
+    pub record: Option<PathBuf>,
+    /// Write the walk's Fig. 6 (target, controller and simulator for the CoM and both feet) to
+    /// `DIR/fig6-<robot>.svg`.
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
 }
 
 /// What the demo measured.
@@ -96,6 +108,10 @@ pub struct DemoOutcome {
     /// Largest tilt of the simulated `base_link` since submission (rad); `None` when no
     /// simulator published its truth (e.g. a running walkd driving a real robot).
     pub max_tilt_rad: Option<f64>,
+    /// The recording, with `--record`.
+    pub recording: Option<RecorderOutcome>,
+    /// The Fig. 6 plot, with `--plots`.
+    pub plot: Option<PathBuf>,
 }
 
 impl DemoOutcome {
@@ -133,6 +149,13 @@ impl DemoOutcome {
             "latency_us": tick(&self.status.latency_us),
             "clock": self.status.clock.name(),
             "rate_hz": self.status.rate_hz,
+            "plot": self.plot,
+            "recording": self.recording.as_ref().map(|r| serde_json::json!({
+                "file": r.summary.path,
+                "messages": r.summary.messages,
+                "bytes": r.summary.bytes,
+                "observer": r.report.json(),
+            })),
         })
     }
 }
@@ -158,16 +181,20 @@ fn default_config(robot: DemoRobot) -> anyhow::Result<PathBuf> {
 }
 
 /// A forward walk of `distance` on the feet for `robot`, post-processed with the config's
-/// `[postprocess]`: the sequence's JSON and its number of stances.
+/// parameters for `gait` (which the sequence then asks walkd for).
 pub fn walk_sequence(
     robot: &Robot,
     file: &ConfigFile,
     distance: f64,
     seed: u64,
-) -> anyhow::Result<(String, usize)> {
-    let params = stance::PostProcessParams::from_config(file)?;
-    let processed = stance::synthetic_walk(robot, &params, &WalkRequest::feet(distance, seed))?;
-    Ok((processed.to_json_string(), processed.len()))
+    gait: Gait,
+) -> anyhow::Result<stance::PostProcessedSequence> {
+    let params = stance::PostProcessParams::from_config_for(file, gait)?;
+    Ok(stance::synthetic_walk(
+        robot,
+        &params,
+        &WalkRequest::feet(distance, seed),
+    )?)
 }
 
 /// Runs the demo and returns what it measured (also used by the e2e tests).
@@ -182,8 +209,14 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         .service_prefix
         .clone()
         .unwrap_or(runtime.service_prefix);
-    let robot = Robot::from_config(&file, args.urdf.as_deref())?;
-    let (json, stance_count) = walk_sequence(&robot, &file, args.distance, args.seed)?;
+    let robot = std::sync::Arc::new(Robot::from_config(&file, args.urdf.as_deref())?);
+    let gait = match args.gait {
+        Some(gait) => gait,
+        None => Gait::configured_default(&file)?,
+    };
+    let sequence = walk_sequence(&robot, &file, args.distance, args.seed, gait)?;
+    let (json, stance_count) = (sequence.to_json_string(), sequence.len());
+    let mut targets = crate::evaluate::stance_points(&robot, &sequence);
 
     let mut children = Processes::default();
     let running = DaemonClient::connect(&prefix).is_ok_and(|client| client.is_running());
@@ -197,19 +230,40 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
             urdf: args.urdf.clone(),
         };
         children.0.push(launch.walkd(&[], &[])?);
-        children.0.push(launch.walk_sim(args.physics)?);
+        children.0.push(launch.walk_sim(args.physics, &[])?);
     }
     let client = connect_when_fresh(&prefix, &children.0, Duration::from_secs(20))?;
+    let observer = args
+        .record
+        .as_ref()
+        .map(|dir| {
+            let file = dir.join(format!("demo-{}.mcap", args.robot.name()));
+            Recorder::start(&prefix, std::sync::Arc::clone(&robot), &file)
+        })
+        .transpose()?;
     let recorder = TruthRecorder::start(&prefix)?;
     let start = client.status()?;
+    crate::evaluate::align_targets(
+        &mut targets,
+        &sequence,
+        &[
+            crate::evaluate::pose_of(&start.left_foot),
+            crate::evaluate::pose_of(&start.right_foot),
+        ],
+    );
     let wall = Instant::now();
     let submitted_ns = shm_types::monotonic_ns();
     let id = client.submit_json(&json)?;
     let progress = (!args.json).then(StanceProgress::new);
     let timeout = Duration::from_secs(60 + 30 * stance_count as u64);
+    let (mut trace, mut status_times) = (Vec::new(), Vec::new());
     let last = client.wait_for_sequence(id, timeout, |status| {
         if let Some(progress) = &progress {
             progress.update(status);
+        }
+        if args.plots.is_some() && status.sequence_id == id {
+            trace.push(crate::evaluate::sample(status, &start, &targets));
+            status_times.push(status.timestamp_ns);
         }
     })?;
     if let Some(progress) = &progress {
@@ -219,7 +273,25 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     // Let a final status with the complete tick statistics arrive.
     let status = client.status().unwrap_or(last);
     drop(client);
-    let verdict = Verdict::of(&recorder.finish()?, submitted_ns);
+    let recording = observer.map(Recorder::finish).transpose()?;
+    let states = recorder.finish()?;
+    let verdict = Verdict::of(&states, submitted_ns);
+    let plot = match &args.plots {
+        Some(dir) => {
+            crate::evaluate::pair_with_truth(&mut trace, &status_times, &states);
+            std::fs::create_dir_all(dir)?;
+            let file = dir.join(format!("fig6-{}.svg", args.robot.name()));
+            let title = format!(
+                "{}, {} m, walkctl demo --physics {}",
+                args.robot.name(),
+                args.distance,
+                args.physics.name()
+            );
+            crate::evaluate::write_fig6(&file, &title, &trace)?;
+            Some(file)
+        }
+        None => None,
+    };
     let problems = children.shut_down()?;
     if !problems.is_empty() {
         bail!("shutting down: {}", problems.join("; "));
@@ -236,6 +308,8 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         wall_s,
         fell_at_s: verdict.and_then(|v| v.fell_at_s),
         max_tilt_rad: verdict.map(|v| v.max_tilt_rad),
+        recording,
+        plot,
         status,
     })
 }
@@ -262,6 +336,28 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
             outcome.sim_s / outcome.wall_s,
             status_text(&outcome.status)
         );
+        if let Some(recording) = &outcome.recording {
+            println!(
+                "recording: {} ({} messages, {:.1} MB; the observer lost {} telemetries, {} \
+                 samples, {} commands)\n  open it in Foxglove (Open local file; docs/observe.md \
+                 lists the channels), or read it with `python3 tests/python/check_recording.py \
+                 {} docs/observe.md`",
+                recording.summary.path.display(),
+                recording.summary.messages,
+                recording.summary.bytes as f64 / 1e6,
+                recording.report.telemetry.lost,
+                recording.report.samples.lost,
+                recording.report.commands.lost,
+                recording.summary.path.display()
+            );
+        }
+        if let Some(plot) = &outcome.plot {
+            println!(
+                "plot: {} (Fig. 6: target, controller and simulator of the CoM and both feet; \
+                 open it in a web browser)",
+                plot.display()
+            );
+        }
     }
     if !outcome.succeeded() {
         bail!("the walk did not complete: {}", outcome.outcome());

@@ -15,6 +15,7 @@
 //! only): target vs controller state vs simulator over time for the CoM and both feet
 //! ([`write_fig6`] is shared with the in-process physics walk of the `walk-tests` package).
 
+pub mod filmstrip;
 pub(crate) mod truth;
 
 use std::fmt::Write as _;
@@ -69,6 +70,16 @@ pub struct EvaluateArgs {
     /// Write Fig. 6 per robot (`fig6_<robot>.svg`) into this directory.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
+    /// Pictures of the walk (MuJoCo's offscreen renderer in walk-sim, built with --features
+    /// sim-adapter/render): per robot, of its first run of the first distance and affordance set,
+    /// a side view every 0.5 s of simulated time in `DIR/frames-<robot>/` and the filmstrip
+    /// `DIR/filmstrip-<robot>.png` (the paper's Fig. 5).
+    #[arg(long, value_name = "DIR")]
+    pub snapshots: Option<PathBuf>,
+    /// Record every run (an observer beside walkd) to
+    /// `DIR/<robot>-<affordances>-<distance>m-run<run>.mcap`.
+    #[arg(long, value_name = "DIR")]
+    pub record: Option<PathBuf>,
 }
 
 /// The CoM and both soles' positions in the world (m).
@@ -160,7 +171,7 @@ pub fn align_targets(
 }
 
 /// The pose a status carries as `[x, y, z, qx, qy, qz, qw]`.
-fn pose_of(pose: &[f64; 7]) -> Isometry3<f64> {
+pub(crate) fn pose_of(pose: &[f64; 7]) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(pose[0], pose[1], pose[2]),
         UnitQuaternion::from_quaternion(Quaternion::new(pose[6], pose[3], pose[4], pose[5])),
@@ -332,11 +343,34 @@ fn run_once(
         rate_hz: None,
         urdf: args.urdf.clone(),
     };
+    let pictured = args.snapshots.as_ref().filter(|_| {
+        run == 0 && distance == args.distances[0] && affordances == args.affordances[0]
+    });
+    let frames = pictured.map(|dir| dir.join(format!("frames-{robot}")));
+    let mut sim_args: Vec<std::ffi::OsString> = Vec::new();
+    if let Some(frames) = &frames {
+        let _ = std::fs::remove_dir_all(frames);
+        // The side camera looks at the middle of the walk (it starts at x = 0 along +x).
+        let lookat = format!("{},0,0.8", distance / 2.0);
+        sim_args.extend(["--snapshots".into(), frames.into()]);
+        sim_args.extend(["--snapshot-lookat".into(), lookat.into()]);
+    }
     let processes = [
         launch.walkd(&["--no-lock-memory"], &[])?,
-        launch.walk_sim(args.physics)?,
+        launch.walk_sim(args.physics, &sim_args)?,
     ];
     let client = connect_when_fresh(&prefix, &processes, Duration::from_secs(30))?;
+    let observer = args
+        .record
+        .as_ref()
+        .map(|dir| {
+            let file = dir.join(format!(
+                "{robot}-{}-{distance}m-run{run}.mcap",
+                affordances.name()
+            ));
+            crate::observe::Recorder::start(&prefix, std::sync::Arc::new(model.clone()), &file)
+        })
+        .transpose()?;
     let recorder = truth::TruthRecorder::start(&prefix)?;
     let start = client.status()?;
     align_targets(
@@ -358,6 +392,9 @@ fn run_once(
     })?;
     let wall_s = wall.elapsed().as_secs_f64();
     drop(client);
+    if let Some(observer) = observer {
+        observer.finish()?;
+    }
     let states = recorder.finish()?;
     let [walkd, sim] = processes;
     let walkd_log = walkd.stop()?.log;
@@ -368,6 +405,22 @@ fn run_once(
              walk-sim's log:\n{sim_log}\nwalkd's log:\n{walkd_log}"
         );
     };
+    if let (Some(dir), Some(frames)) = (pictured, &frames) {
+        let start = truth::state_at(&states, submitted_ns).map_or(0.0, |s| s.sim_time_s);
+        let end = truth::state_at(&states, last.timestamp_ns)
+            .map_or(verdict.end.sim_time_s, |s| s.sim_time_s);
+        let strip = dir.join(format!("filmstrip-{robot}.png"));
+        let times = filmstrip::write_filmstrip(frames, start, end, &strip)?;
+        eprintln!(
+            "{}: {robot} at {} s of simulated time",
+            strip.display(),
+            times
+                .iter()
+                .map(|t| format!("{:.1}", t - start))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     let drift = pair_with_truth(&mut trace, &status_times, &states);
     let end = Points::from_truth(&verdict.end);
     let final_target = targets[targets.len() - 1];
@@ -397,7 +450,11 @@ fn run_once(
     })
 }
 
-fn sample(status: &DaemonStatus, start: &DaemonStatus, targets: &[Points]) -> TraceSample {
+pub(crate) fn sample(
+    status: &DaemonStatus,
+    start: &DaemonStatus,
+    targets: &[Points],
+) -> TraceSample {
     let index = (status.stance_index as usize).min(targets.len() - 1);
     TraceSample {
         t: (status.ticks.saturating_sub(start.ticks)) as f64 / status.rate_hz,
@@ -411,7 +468,7 @@ fn sample(status: &DaemonStatus, start: &DaemonStatus, targets: &[Points]) -> Tr
 /// Puts the simulator's state into every trace sample whose status (written at `status_times`)
 /// pairs with one; returns the largest controller-vs-simulator distance of the CoM or a sole
 /// and the number of paired samples, or `None` when none paired.
-fn pair_with_truth(
+pub(crate) fn pair_with_truth(
     trace: &mut [TraceSample],
     status_times: &[u64],
     states: &[SimTruth],

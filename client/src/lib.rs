@@ -14,6 +14,7 @@ pub mod evaluate;
 pub mod generate;
 pub mod inspect;
 pub mod learn;
+pub mod observe;
 pub mod postprocess;
 pub mod process;
 pub mod status;

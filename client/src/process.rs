@@ -247,13 +247,11 @@ impl Launch {
         args
     }
 
-    /// Starts `walk-sim` with `physics`.
-    pub fn walk_sim(&self, physics: Physics) -> anyhow::Result<Process> {
-        Process::start(
-            &self.bin_dir.join("walk-sim"),
-            self.walk_sim_args(physics),
-            &[],
-        )
+    /// Starts `walk-sim` with `physics` and `extra` arguments.
+    pub fn walk_sim(&self, physics: Physics, extra: &[OsString]) -> anyhow::Result<Process> {
+        let mut args = self.walk_sim_args(physics);
+        args.extend_from_slice(extra);
+        Process::start(&self.bin_dir.join("walk-sim"), args, &[])
     }
 }
 

@@ -19,6 +19,7 @@ pub mod ik;
 pub mod kinematics;
 pub mod model;
 pub mod robot;
+pub mod skeleton;
 
 pub use nalgebra::{DMatrix, DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
 
@@ -28,3 +29,4 @@ pub use ik::{IkError, IkOptions, IkSolution, IkSolver, IkTarget};
 pub use kinematics::{FrameSet, Kinematics};
 pub use model::{FrameId, JointLimits, LinkId, Model, ModelError};
 pub use robot::{EndEffector, JointGroups, Robot, RobotError, SoleRectangle};
+pub use skeleton::{LinkShape, Part, Shape};

@@ -11,14 +11,16 @@
 //! | `stances` | request-response | client → daemon | JSON bytes → [`SubmitReply`] |
 //! | `control` | request-response | client → daemon | [`ControlRequest`] → [`ControlReply`] |
 //! | `sim-truth` | publish-subscribe | simulator → clients | [`SimTruth`] |
+//! | `telemetry` | publish-subscribe | daemon → observers | [`Telemetry`], one per control tick |
 //!
 //! Every message type is `#[repr(C)]`, `ZeroCopySend` and carries a `#[type_name]` that contains
 //! the [`PROTOCOL_VERSION`]; a peer built against another protocol version is refused by iceoryx2
 //! when it opens a service and the port wrappers turn that into [`ShmError::ProtocolMismatch`].
 //!
 //! Processes never touch iceoryx2 directly: each role has a typed port wrapper
-//! ([`DaemonLoopPorts`] + [`DaemonServicePorts`], [`AdapterPorts`], [`ClientPorts`], and for the
-//! simulator's ground truth [`TruthPublisher`] + [`TruthSubscriber`]) that opens the services with
+//! ([`DaemonLoopPorts`] + [`DaemonServicePorts`], [`AdapterPorts`], [`ClientPorts`],
+//! [`ObserverPorts`] for observers, and for the simulator's ground truth [`TruthPublisher`] +
+//! [`TruthSubscriber`]) that opens the services with
 //! the one set of QoS settings defined in [`services`].
 
 mod clock;
@@ -28,11 +30,13 @@ mod messages;
 pub mod ports;
 pub mod process;
 pub mod services;
+mod telemetry;
 mod text;
 pub mod wire;
 
 pub use ports::{
-    AdapterPorts, ClientPorts, DaemonLoopPorts, DaemonServicePorts, TruthPublisher, TruthSubscriber,
+    AdapterPorts, ClientPorts, DaemonLoopPorts, DaemonServicePorts, Observed, ObserverPorts,
+    TruthPublisher, TruthSubscriber,
 };
 
 pub use clock::{current_thread_is_fifo, monotonic_ns, sleep_then_spin_until, sleep_until};
@@ -46,6 +50,7 @@ pub use messages::{
 pub use wire::{Code, DecodeError, Flag};
 
 pub use services::ServiceNames;
+pub use telemetry::{SUPPORT_VERTICES, Telemetry, WalkPhase};
 pub use text::FixedText;
 
 /// Version of the wire protocol; part of every message's `#[type_name]`. Version 2: enums and

@@ -17,7 +17,7 @@ use iceoryx2::service::port_factory::{event, publish_subscribe, request_response
 
 use crate::{
     ControlReply, ControlRequest, DaemonStatus, JointCommand, PROTOCOL_VERSION, SensorSample,
-    ShmError, SimTruth, SubmitReply,
+    ShmError, SimTruth, SubmitReply, Telemetry,
 };
 
 /// The names of one robot's services: `<prefix>/sensors`, `<prefix>/commands`, ...
@@ -44,9 +44,23 @@ pub mod capacity {
     pub const CONTROL_CLIENTS: usize = 32;
     /// Clients of `stances` (each holds a data segment for its largest submission).
     pub const STANCES_CLIENTS: usize = 16;
+    /// Subscribers of `telemetry`: observers (`walkctl record`, `view`, `demo --record`).
+    pub const TELEMETRY_SUBSCRIBERS: usize = 8;
     /// Processes' nodes that may open one service.
     pub const NODES: usize = 128;
 }
+
+/// Messages of `sensors` and `commands` an observer's subscriber holds before the oldest is
+/// dropped: 128 ms at 1 kHz, so an observer that drains every few milliseconds loses none. walkd
+/// and the adapters keep only the newest message and subscribe with [`STREAM_PEER_BUFFER`].
+pub const STREAM_OBSERVER_BUFFER: usize = 128;
+
+/// Buffer of walkd's and an adapter's stream subscriber: they take the newest message only.
+pub const STREAM_PEER_BUFFER: usize = 4;
+
+/// Messages of `telemetry` a subscriber holds before the oldest is dropped: 256 ms at 1 kHz
+/// (walkd publishes one per control tick).
+pub const TELEMETRY_BUFFER: usize = 256;
 
 /// The service kinds, used to build names.
 const SENSORS: &str = "sensors";
@@ -55,6 +69,7 @@ const STATUS: &str = "status";
 const STANCES: &str = "stances";
 const CONTROL: &str = "control";
 pub(crate) const SIM_TRUTH: &str = "sim-truth";
+pub(crate) const TELEMETRY: &str = "telemetry";
 
 impl ServiceNames {
     /// Names under `prefix` (e.g. `walk/armar4`); fails if a resulting name is not a valid
@@ -69,7 +84,9 @@ impl ServiceNames {
                 detail: "the service prefix is empty".to_owned(),
             });
         }
-        for kind in [SENSORS, COMMANDS, STATUS, STANCES, CONTROL, SIM_TRUTH] {
+        for kind in [
+            SENSORS, COMMANDS, STATUS, STANCES, CONTROL, SIM_TRUTH, TELEMETRY,
+        ] {
             names.service_name(kind)?;
         }
         Ok(names)
@@ -207,7 +224,8 @@ impl StreamPayload for JointCommand {
 }
 
 /// The stream that carries `T` (sensors, commands): newest wins, a late subscriber gets the last
-/// one.
+/// one. Its subscribers may buffer up to [`STREAM_OBSERVER_BUFFER`] messages (observers); the
+/// peers subscribe with [`STREAM_PEER_BUFFER`].
 pub(crate) fn stream<T: StreamPayload>(
     node: &IpcNode,
     names: &ServiceNames,
@@ -217,7 +235,7 @@ pub(crate) fn stream<T: StreamPayload>(
         .publish_subscribe::<T>()
         .enable_safe_overflow(true)
         .history_size(1)
-        .subscriber_max_buffer_size(4)
+        .subscriber_max_buffer_size(STREAM_OBSERVER_BUFFER)
         .subscriber_max_borrowed_samples(4)
         .max_publishers(capacity::STREAM_PUBLISHERS)
         .max_subscribers(capacity::STREAM_SUBSCRIBERS)
@@ -284,6 +302,26 @@ pub(crate) fn sim_truth(
         .subscriber_max_borrowed_samples(2)
         .max_publishers(2)
         .max_subscribers(capacity::STREAM_SUBSCRIBERS)
+        .max_nodes(capacity::NODES)
+        .open_or_create()
+        .map_err(|e| pubsub_error(&service, e))
+}
+
+/// The control thread's per-tick telemetry: published by walkd, drained by observers. Both sides
+/// open or create it, so either may start first.
+pub(crate) fn telemetry(
+    node: &IpcNode,
+    names: &ServiceNames,
+) -> Result<PubSub<Telemetry>, ShmError> {
+    let service = names.full(TELEMETRY);
+    node.service_builder(&names.service_name(TELEMETRY)?)
+        .publish_subscribe::<Telemetry>()
+        .enable_safe_overflow(true)
+        .history_size(1)
+        .subscriber_max_buffer_size(TELEMETRY_BUFFER)
+        .subscriber_max_borrowed_samples(2)
+        .max_publishers(2)
+        .max_subscribers(capacity::TELEMETRY_SUBSCRIBERS)
         .max_nodes(capacity::NODES)
         .open_or_create()
         .map_err(|e| pubsub_error(&service, e))

@@ -40,6 +40,26 @@ impl Gait {
             Self::Dynamic => "dynamic",
         }
     }
+
+    /// `[gait] default` of a robot config: the gait of a walk that does not ask for one
+    /// (static when absent). Read here because both sides need it: the client post-processes
+    /// with that gait's limits, the daemon walks a file that names no gait with it. The rest of
+    /// `[gait]` is the daemon's.
+    pub fn configured_default(file: &ConfigFile) -> Result<Self, ParamsError> {
+        let Some(value) = file.section("gait").and_then(|gait| gait.get("default")) else {
+            return Ok(Self::Static);
+        };
+        let fail = |message: String| ParamsError::Key {
+            path: file.path().to_owned(),
+            section: "gait",
+            message,
+        };
+        value
+            .as_str()
+            .ok_or_else(|| fail(format!("`default` must be a string, not {value}")))?
+            .parse()
+            .map_err(|e: String| fail(format!("`default`: {e}")))
+    }
 }
 
 impl std::str::FromStr for Gait {
@@ -288,6 +308,26 @@ mod tests {
                 ..fixed
             }
         );
+    }
+
+    #[test]
+    fn the_default_gait_is_static_unless_the_config_says_otherwise() {
+        let read = |text: &str| {
+            Gait::configured_default(&ConfigFile::parse(text, Path::new("r.toml")).unwrap())
+        };
+        assert_eq!(read("").unwrap(), Gait::Static);
+        assert_eq!(read("[gait]\n").unwrap(), Gait::Static);
+        assert_eq!(
+            read("[gait]\ndefault = \"dynamic\"\n").unwrap(),
+            Gait::Dynamic
+        );
+        for bad in ["[gait]\ndefault = \"fast\"\n", "[gait]\ndefault = 1\n"] {
+            let error = read(bad).unwrap_err().to_string();
+            assert!(
+                error.contains("r.toml") && error.contains("[gait]") && error.contains("default"),
+                "{error}"
+            );
+        }
     }
 
     #[test]

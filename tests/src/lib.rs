@@ -80,7 +80,7 @@ pub fn start_walkd_with_env(
 /// Starts `walk-sim --physics kinematic` for `robot` on `prefix`.
 pub fn start_sim(robot: &str, prefix: &str, clock: &str, rate_hz: f64) -> anyhow::Result<Process> {
     check_binaries()?;
-    launch(robot, prefix, clock, rate_hz).walk_sim(Physics::Kinematic)
+    launch(robot, prefix, clock, rate_hz).walk_sim(Physics::Kinematic, &[])
 }
 
 /// Fails with how to build them if the binaries under test are missing.
@@ -176,5 +176,6 @@ pub fn start_walking(
 pub fn walk_json(robot: &str, distance: f64) -> anyhow::Result<(String, usize)> {
     let file = kinematics::ConfigFile::load(&config(robot))?;
     let model = kinematics::robot::Robot::from_config(&file, None)?;
-    client::demo::walk_sequence(&model, &file, distance, 1)
+    let sequence = client::demo::walk_sequence(&model, &file, distance, 1, stance::Gait::Static)?;
+    Ok((sequence.to_json_string(), sequence.len()))
 }

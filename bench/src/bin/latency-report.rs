@@ -103,7 +103,8 @@ fn start_load() -> anyhow::Result<Processes> {
 fn long_walk(config: &Path) -> anyhow::Result<String> {
     let file = ConfigFile::load(config)?;
     let robot = Robot::from_config(&file, None)?;
-    let (json, _) = client::demo::walk_sequence(&robot, &file, 20.0, 7)?;
+    let gait = stance::Gait::configured_default(&file)?;
+    let json = client::demo::walk_sequence(&robot, &file, 20.0, 7, gait)?.to_json_string();
     Ok(json)
 }
 
@@ -159,7 +160,7 @@ fn measure(args: &Args, walk: &str, rate_hz: f64, load: Load) -> anyhow::Result<
             chrt_args.extend(sim);
             Process::start(Path::new("chrt"), chrt_args, &[])?
         }
-        None => launch.walk_sim(Physics::Kinematic)?,
+        None => launch.walk_sim(Physics::Kinematic, &[])?,
     });
 
     let names = ServiceNames::new(&prefix)?;

@@ -41,6 +41,10 @@ enum Command {
     Demo(client::demo::DemoArgs),
     /// The paper's evaluation: robots × affordance sets × distances × runs under walk-sim.
     Evaluate(client::evaluate::EvaluateArgs),
+    /// Record a running walkd's streams to an MCAP file (an observer; walkd is not disturbed).
+    Record(client::observe::RecordArgs),
+    /// Serve a running walkd's streams live to Foxglove over its WebSocket protocol.
+    View(client::observe::ViewArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -54,6 +58,8 @@ fn main() -> std::process::ExitCode {
         Command::Hold(args) => client::control::run(args, shm_types::ControlCommand::Hold),
         Command::Demo(args) => client::demo::run(args),
         Command::Evaluate(args) => client::evaluate::run(args),
+        Command::Record(args) => client::observe::run_record(args),
+        Command::View(args) => client::observe::run_view(args),
         Command::Generate(args) => client::generate::run(args),
         Command::Postprocess(args) => client::postprocess::run(args),
         Command::BenchPostprocess(args) => client::bench_postprocess::run(args),

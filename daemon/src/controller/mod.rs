@@ -36,6 +36,7 @@ mod plan;
 mod sequence;
 mod sequencer;
 mod status;
+mod telemetry;
 mod trajectory;
 
 use std::sync::Arc;
@@ -53,6 +54,7 @@ pub use status::{
     BalanceStatus, ControllerState, ControllerStatus, FaultCode, FaultDescription,
     MeasurementFault, Phase,
 };
+pub use telemetry::ControllerTelemetry;
 
 use assembly::QpAssembler;
 use estimator::BaseEstimator;

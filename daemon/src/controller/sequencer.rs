@@ -11,6 +11,7 @@ use super::gait::{DynamicWalker, Sensors};
 use super::machine::{Feedback, Progress, StateMachine, Targets};
 use super::sequence::PreparedSequence;
 use super::status::{BalanceStatus, Phase};
+use stance::Gait;
 
 /// Both gaits' state machines; see the module docs.
 pub(crate) struct Sequencer {
@@ -102,6 +103,15 @@ impl Sequencer {
             self.dynamic.posture()
         } else {
             self.fallback.posture()
+        }
+    }
+
+    /// The gait of the last loaded sequence (static before the first).
+    pub fn gait(&self) -> Gait {
+        if self.dynamic_selected {
+            Gait::Dynamic
+        } else {
+            Gait::Static
         }
     }
 

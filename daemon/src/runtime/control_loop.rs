@@ -31,6 +31,10 @@
 //! and adds what followed ([`FaultLog`]); a second process publishing on `sensors` stops any
 //! walk and is reported there too.
 //!
+//! After each tick's command the tick's telemetry (estimate, set-points, support polygon, timing)
+//! goes out on `telemetry` for observers ([`super::telemetry`]); nothing is published between
+//! the sample and the command.
+//!
 //! After start-up nothing here allocates, frees, locks or logs per tick.
 
 use std::sync::Arc;
@@ -47,6 +51,7 @@ use super::sample_gate::{SampleGate, Verdict};
 use super::shared::{ControlOutcome, Shared, StartOutcome};
 use super::snapshot::SnapshotWriter;
 use super::stats::{LoopStats, MissRecord, log_histogram, record, summarize};
+use super::telemetry::{self, TickRecord};
 use crate::controller::{
     Command, CommandMode, Controller, ControllerState, FaultCode, PreparedSequence,
 };
@@ -103,6 +108,8 @@ pub struct ControlLoop {
     sample_taken_ns: u64,
     command: Command,
     command_seq: u64,
+    /// Telemetries published (the last one's `seq`).
+    telemetry_seq: u64,
     stats: LoopStats,
     link: LinkState,
     stale_in_row: u32,
@@ -144,6 +151,7 @@ impl ControlLoop {
             sample_taken_ns: 0,
             command: Command::new(dof),
             command_seq: 0,
+            telemetry_seq: 0,
             stats: LoopStats::new(),
             link: LinkState::Waiting,
             stale_in_row: 0,
@@ -388,6 +396,7 @@ impl ControlLoop {
             );
         }
         self.stats.ticks += 1;
+        self.publish_telemetry(commanded, computed_ns - tick_start, sent_ns);
         let changed = self.note_state_change();
         self.housekeeping();
         if changed || sent_ns >= self.next_status_ns {
@@ -423,6 +432,31 @@ impl ControlLoop {
             out.q_des[..n].copy_from_slice(command.q_des.as_slice());
             out.qd_des[..n].copy_from_slice(command.qd_des.as_slice());
         })
+    }
+
+    /// Publishes the tick's telemetry for observers: after the command, so it never delays one. A
+    /// failed publication costs the observers one message (a gap in its `seq`) and is counted;
+    /// it does not stop the robot.
+    fn publish_telemetry(&mut self, commanded: bool, compute_ns: u64, sent_ns: u64) {
+        self.telemetry_seq += 1;
+        let record = TickRecord {
+            seq: self.telemetry_seq,
+            tick: self.stats.ticks,
+            sample_seq: self.sample.seq,
+            sample_timestamp_ns: self.sample.timestamp_ns,
+            command_seq: if commanded { self.command_seq } else { 0 },
+            sent_ns,
+            compute_ns,
+            deadline_misses: self.stats.deadline_misses,
+            state: self.daemon_state(),
+        };
+        let controller = self.controller.telemetry();
+        let published = self
+            .ports
+            .publish_telemetry(|out| telemetry::fill(out, &record, &controller));
+        if published.is_err() {
+            self.stats.telemetry_failures += 1;
+        }
     }
 
     /// Realtime: a period ended without a fresh sample.

@@ -2,8 +2,9 @@
 //!
 //! Threads:
 //! - the **control thread** ([`control_loop`]) waits for sensor samples, ticks the controller at a
-//!   fixed rate (or once per sample in lockstep) and sends joint commands; it allocates, frees,
-//!   locks and logs nothing per tick;
+//!   fixed rate (or once per sample in lockstep), sends joint commands and, after each command,
+//!   the tick's telemetry for observers ([`telemetry`]); it allocates, frees, locks and logs
+//!   nothing per tick;
 //! - the **main thread** ([`service`]) serves sequence submissions and control requests, publishes
 //!   the status at `[runtime] status_rate_hz`, and talks to systemd.
 //!
@@ -26,6 +27,7 @@ mod service;
 mod shared;
 mod snapshot;
 mod stats;
+mod telemetry;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -233,6 +235,7 @@ fn run(args: &DaemonArgs) -> Result<(), Failure> {
         deadline_misses = stats.deadline_misses,
         stale_periods = stats.stale_periods,
         watchdog_trips = stats.watchdog_trips,
+        telemetry_failures = stats.telemetry_failures,
         "walkd stopped"
     );
     Ok(())

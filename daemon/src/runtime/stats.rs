@@ -31,6 +31,8 @@ pub struct LoopStats {
     pub stale_periods: u64,
     /// Times the sample watchdog tripped.
     pub watchdog_trips: u64,
+    /// Ticks whose telemetry could not be published (observers saw a gap).
+    pub telemetry_failures: u64,
 }
 
 impl LoopStats {
@@ -50,6 +52,7 @@ impl LoopStats {
             deadline_misses: 0,
             stale_periods: 0,
             watchdog_trips: 0,
+            telemetry_failures: 0,
         }
     }
 }

@@ -249,6 +249,26 @@ impl Model {
         self.bodies.len()
     }
 
+    /// The parent of a link (`None` for the floating base): links form a tree, parents first.
+    pub fn link_parent(&self, link: LinkId) -> Option<LinkId> {
+        self.bodies[link.0].parent.map(LinkId)
+    }
+
+    /// Mass of a link alone (kg).
+    pub fn link_mass(&self, link: LinkId) -> f64 {
+        self.bodies[link.0].mass
+    }
+
+    /// Pose of a link's joint frame in its parent link's frame (the link's pose there at q = 0).
+    pub fn link_origin(&self, link: LinkId) -> &Isometry3<f64> {
+        &self.bodies[link.0].origin
+    }
+
+    /// A link's centre of mass in its own frame.
+    pub fn link_com(&self, link: LinkId) -> &Vector3<f64> {
+        &self.bodies[link.0].com
+    }
+
     pub(crate) fn bodies(&self) -> &[Body] {
         &self.bodies
     }

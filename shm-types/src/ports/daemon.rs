@@ -7,29 +7,38 @@ use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
 
 use super::stream::{StreamReceiver, StreamSender};
+use super::telemetry::TelemetrySender;
 use crate::services::{self, Access, ControlService, IpcNode, PubSub, SubmitService};
 use crate::{
     ControlCommand, ControlReply, ControlRequest, DaemonStatus, DecodeError, JointCommand,
-    SensorSample, ServiceNames, ShmError, SubmitReply,
+    SensorSample, ServiceNames, ShmError, SubmitReply, Telemetry,
 };
 
-/// The control thread's ports: sensor samples in, joint commands out. All operations are
-/// allocation-free after `open`.
+/// The control thread's ports: sensor samples in, joint commands and telemetry out. All
+/// operations are allocation-free after `open`.
 pub struct DaemonLoopPorts {
     sensors: StreamReceiver<SensorSample>,
     commands: StreamSender<JointCommand>,
+    telemetry: TelemetrySender,
     _node: IpcNode,
 }
 
 impl DaemonLoopPorts {
-    /// Opens (or creates) `sensors` and `commands` under `names`.
+    /// Opens (or creates) `sensors`, `commands` and `telemetry` under `names`.
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, _) = services::create_node(node_name)?;
         Ok(Self {
             sensors: StreamReceiver::open(&node, names)?,
             commands: StreamSender::open(&node, names)?,
+            telemetry: TelemetrySender::open(&node, names)?,
             _node: node,
         })
+    }
+
+    /// Writes one tick's telemetry in place and publishes it to the observers (no wake-up, no
+    /// system call). Call it after the tick's command was sent.
+    pub fn publish_telemetry(&self, fill: impl FnOnce(&mut Telemetry)) -> Result<(), ShmError> {
+        self.telemetry.send(fill)
     }
 
     /// Blocks until the adapter announces a sample or `timeout` passes.

@@ -4,10 +4,13 @@
 mod adapter;
 mod client;
 mod daemon;
+mod observer;
 mod stream;
+mod telemetry;
 mod truth;
 
 pub use adapter::AdapterPorts;
 pub use client::ClientPorts;
 pub use daemon::{DaemonLoopPorts, DaemonServicePorts};
+pub use observer::{Observed, ObserverPorts};
 pub use truth::{TruthPublisher, TruthSubscriber};

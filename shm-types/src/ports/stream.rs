@@ -82,6 +82,7 @@ impl<T: StreamPayload> StreamReceiver<T> {
         let event = services::stream_event::<T>(node, names)?;
         let subscriber = service
             .subscriber_builder()
+            .buffer_size(services::STREAM_PEER_BUFFER)
             .create()
             .map_err(|e| ShmError::ipc("create subscriber on", &service_name, e))?;
         let listener = event

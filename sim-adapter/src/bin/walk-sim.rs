@@ -3,7 +3,10 @@
 //! ```text
 //! walk-sim --config configs/armar4.toml --physics kinematic|mujoco [--clock realtime|lockstep]
 //!          [--rate-hz F] [--urdf PATH] [--service-prefix P]
+//!          [--snapshots DIR [--snapshot-period S] [--snapshot-lookat X,Y,Z]]
 //! ```
+//! With `--snapshots` (MuJoCo only, feature `render`) it saves a side view of the robot every
+//! `--snapshot-period` of simulated time (`sim_adapter::mujoco::render`).
 //! Besides the adapter side of the contract it publishes the simulator's ground truth (CoM,
 //! sole poses, base height and tilt, fall flag) on `<prefix>/sim-truth` with every sample.
 //!
@@ -46,6 +49,17 @@ struct Args {
     /// Service prefix, overriding `[runtime] service_prefix`.
     #[arg(long)]
     service_prefix: Option<String>,
+    /// `--physics mujoco`: save a picture of the robot (MuJoCo's offscreen renderer, EGL) every
+    /// `--snapshot-period` of simulated time into this directory (needs --features
+    /// sim-adapter/render).
+    #[arg(long, value_name = "DIR")]
+    snapshots: Option<PathBuf>,
+    /// Simulated time between two pictures (s).
+    #[arg(long, default_value_t = 0.5)]
+    snapshot_period: f64,
+    /// The point the side camera looks at: x,y,z (m, world).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.0, 0.8])]
+    snapshot_lookat: Vec<f64>,
 }
 
 fn main() -> ExitCode {
@@ -94,7 +108,7 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
                 .map_err(|e| config_error(anyhow::Error::from(e).context("standing posture")))?;
             serve(&runtime, args.clock, SimulatedRobot::new(sim))
         }
-        Physics::Mujoco => serve_mujoco(robot, &runtime, args.clock),
+        Physics::Mujoco => serve_mujoco(robot, &runtime, args),
     }
 }
 
@@ -103,7 +117,7 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
 fn serve_mujoco(
     robot: Arc<Robot>,
     runtime: &RuntimeConfig,
-    clock: ClockMode,
+    args: &Args,
 ) -> Result<(), (u8, anyhow::Error)> {
     use sim_adapter::mujoco::{MujocoOptions, MujocoSim};
     let (urdf, standing) = (robot.urdf.clone(), robot.standing.clone());
@@ -113,7 +127,47 @@ fn serve_mujoco(
             anyhow::Error::from(e).context("MuJoCo model"),
         )
     })?;
-    serve(runtime, clock, SimulatedRobot::new(sim))
+    match &args.snapshots {
+        None => serve(runtime, args.clock, SimulatedRobot::new(sim)),
+        Some(dir) => serve_with_snapshots(runtime, args, sim, dir),
+    }
+}
+
+/// `--snapshots DIR`: the MuJoCo robot photographed while it walks.
+#[cfg(feature = "render")]
+fn serve_with_snapshots(
+    runtime: &RuntimeConfig,
+    args: &Args,
+    sim: sim_adapter::mujoco::MujocoSim,
+    dir: &std::path::Path,
+) -> Result<(), (u8, anyhow::Error)> {
+    use sim_adapter::mujoco::render::{PhotographedSim, SnapshotOptions};
+    let &[x, y, z] = args.snapshot_lookat.as_slice() else {
+        return Err((
+            exit_code::USAGE,
+            anyhow::anyhow!("--snapshot-lookat takes x,y,z (three numbers)"),
+        ));
+    };
+    let options = SnapshotOptions::side_view(dir.to_owned(), args.snapshot_period, [x, y, z]);
+    let sim = PhotographedSim::new(sim, options)
+        .map_err(|e| (exit_code::CONFIG, anyhow::Error::from(e)))?;
+    serve(runtime, args.clock, SimulatedRobot::new(sim))
+}
+
+/// `--snapshots DIR` in a build without the renderer: says how to get it.
+#[cfg(all(feature = "mujoco", not(feature = "render")))]
+fn serve_with_snapshots(
+    _runtime: &RuntimeConfig,
+    _args: &Args,
+    _sim: sim_adapter::mujoco::MujocoSim,
+    _dir: &std::path::Path,
+) -> Result<(), (u8, anyhow::Error)> {
+    Err((
+        exit_code::CONFIG,
+        anyhow::anyhow!(
+            "walk-sim was built without the renderer: rebuild it with --features sim-adapter/render"
+        ),
+    ))
 }
 
 /// `--physics mujoco` in a build without the backend: says how to get it.
@@ -121,7 +175,7 @@ fn serve_mujoco(
 fn serve_mujoco(
     _robot: Arc<Robot>,
     _runtime: &RuntimeConfig,
-    _clock: ClockMode,
+    _args: &Args,
 ) -> Result<(), (u8, anyhow::Error)> {
     Err((
         exit_code::CONFIG,

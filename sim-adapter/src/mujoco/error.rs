@@ -29,6 +29,9 @@ pub enum MujocoError {
     /// MuJoCo rejected the generated model.
     #[error("MuJoCo could not compile the generated model: {0}")]
     Compile(String),
+    /// Drawing or saving a picture failed (feature `render`).
+    #[error("rendering: {0}")]
+    Render(String),
     /// An option is out of range.
     #[error("MuJoCo option `{name}` = {value} must be {requirement}")]
     BadOption {

@@ -8,7 +8,11 @@
 //!   rectangle with its bottom face on the sole frame, colliding with the floor and nothing else;
 //! - sites at every end-effector frame, both FT frames and the base (the IMU);
 //! - per joint a position and a velocity actuator (the servo), in model joint order;
-//! - IMU sensors (orientation, gyro, accelerometer) at the base site.
+//! - IMU sensors (orientation, gyro, accelerometer) at the base site;
+//! - with `visual_geoms`, what pictures need and the physics ignores ([`visuals`](super::visuals)):
+//!   visual-only geoms of the links in geom group [`VISUAL_GROUP`](super::visuals::VISUAL_GROUP)
+//!   (no collision: `contype` = `conaffinity` = 0 by default; no inertia: `inertiafromgeom` is
+//!   false), a floor texture, a sky and an offscreen buffer.
 
 use std::fmt::Write;
 
@@ -19,6 +23,7 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 use super::MujocoError;
 use super::bodies::{MassProperties, RigidBodies};
 use super::options::MujocoOptions;
+use super::visuals::{self, VisualGeom};
 
 /// Name of the floating base's free joint.
 pub(crate) const FREE_JOINT: &str = "floating_base";
@@ -70,13 +75,24 @@ pub(crate) fn write(
         o.friction, o.contact_time_constant
     );
     let _ = writeln!(xml, "  </default>");
+    if o.visual_geoms {
+        xml.push_str(&visuals::scene());
+    }
     let _ = writeln!(xml, "  <worldbody>");
     // The floor collides with whatever has conaffinity 1: only the feet.
+    let floor_material = if o.visual_geoms {
+        visuals::FLOOR_MATERIAL
+    } else {
+        ""
+    };
     let _ = writeln!(
         xml,
-        r#"    <geom name="floor" type="plane" size="0 0 1" contype="1"/>"#
+        r#"    <geom name="floor" type="plane" size="0 0 1" contype="1"{floor_material}/>"#
     );
-    let attachments = Attachments::collect(robot, bodies, o.sole_thickness)?;
+    let mut attachments = Attachments::collect(robot, bodies, o.sole_thickness)?;
+    if o.visual_geoms {
+        attachments.add_visuals(robot, bodies)?;
+    }
     write_body(&mut xml, robot, bodies, &attachments, o, 0, 2);
     let _ = writeln!(xml, "  </worldbody>");
     let _ = writeln!(xml, "  <actuator>");
@@ -117,6 +133,8 @@ enum AttachmentKind {
     Site(&'static str),
     /// A foot collision box: (name, half extents).
     SoleBox(&'static str, Vector3<f64>),
+    /// A visual-only geom (its pose is in the geom; the attachment pose is unused).
+    Visual(VisualGeom),
 }
 
 struct Attachments(Vec<Attachment>);
@@ -163,6 +181,27 @@ impl Attachments {
             });
         }
         Ok(Self(all))
+    }
+
+    /// Adds the visual-only geoms of every link's skeleton shapes.
+    fn add_visuals(&mut self, robot: &Robot, bodies: &RigidBodies) -> Result<(), MujocoError> {
+        let shapes = kinematics::skeleton::skeleton(robot);
+        // The collision boxes draw the soles already (same size and place).
+        for shape in shapes
+            .iter()
+            .filter(|s| s.part != kinematics::skeleton::Part::Sole)
+        {
+            let link = robot.model.link_name(shape.link);
+            let placement = bodies.links.get(link).ok_or_else(|| {
+                MujocoError::ModelMismatch(format!("link '{link}' is not a link of the URDF"))
+            })?;
+            self.0.push(Attachment {
+                body: placement.body,
+                pose: Isometry3::identity(),
+                kind: AttachmentKind::Visual(VisualGeom::new(shape, &placement.offset)),
+            });
+        }
+        Ok(())
     }
 }
 
@@ -241,6 +280,9 @@ fn write_body(
                     half.z,
                     pose_attributes(&attachment.pose)
                 );
+            }
+            AttachmentKind::Visual(ref geom) => {
+                let _ = writeln!(xml, "{pad}  {}", geom.element());
             }
         }
     }

@@ -16,7 +16,10 @@ mod contact;
 mod error;
 mod mjcf;
 mod options;
+#[cfg(feature = "render")]
+pub mod render;
 mod sim;
+mod visuals;
 
 pub use error::MujocoError;
 pub use options::MujocoOptions;

@@ -47,6 +47,10 @@ pub struct MujocoOptions {
     /// Model error: the centre of mass of the body holding the configured `base_link` (the
     /// pelvis) is moved by this offset, in that body's frame (m).
     pub pelvis_com_offset: [f64; 3],
+    /// Give the model what its pictures need (`mjcf`): visual-only geoms drawing the links
+    /// (`kinematics::skeleton`), a floor texture, a sky and an offscreen buffer. They take part in
+    /// no collision and no inertia, so the dynamics are bit-identical either way (tested).
+    pub visual_geoms: bool,
 }
 
 impl Default for MujocoOptions {
@@ -65,6 +69,7 @@ impl Default for MujocoOptions {
             average_ft_over_step: false,
             mass_scale: 1.0,
             pelvis_com_offset: [0.0; 3],
+            visual_geoms: true,
         }
     }
 }

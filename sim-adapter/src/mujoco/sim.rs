@@ -132,6 +132,17 @@ impl MujocoSim {
         &self.options
     }
 
+    /// The compiled MuJoCo model (e.g. to count its geoms or build a renderer for it).
+    pub fn model(&self) -> &MjModel {
+        self.data.model()
+    }
+
+    /// The MuJoCo state, for the renderer (which reads the model and the current state).
+    #[cfg(feature = "render")]
+    pub(crate) fn data_mut(&mut self) -> &mut MjData<Box<MjModel>> {
+        &mut self.data
+    }
+
     /// The IMU at the floating base origin (the URDF root link): angular velocity (rad/s) and
     /// specific force (m/s², from the last constraint solve), both in the base frame.
     pub fn imu_rates(&self) -> (Vector3<f64>, Vector3<f64>) {

@@ -178,7 +178,12 @@ impl GaitConfig {
 
     /// Reads the `[gait]` section of a loaded robot config.
     pub fn from_config(file: &ConfigFile) -> Result<Self, ConfigError> {
-        Self::from_section(file.section(GAIT), &file.origin())
+        let default = Gait::configured_default(file).map_err(|e| ConfigError::Section {
+            origin: file.origin(),
+            section: GAIT,
+            message: e.to_string(),
+        })?;
+        Self::from_section(file.section(GAIT), default, &file.origin())
     }
 
     /// The dynamic gait's tuning, or why a dynamic walk cannot be executed on this robot.
@@ -188,15 +193,21 @@ impl GaitConfig {
         })
     }
 
-    fn from_section(section: Option<&toml::Value>, origin: &str) -> Result<Self, ConfigError> {
+    fn from_section(
+        section: Option<&toml::Value>,
+        default: Gait,
+        origin: &str,
+    ) -> Result<Self, ConfigError> {
         let Some(section) = section else {
             return Ok(Self::default());
         };
         let mut section = sub_table(section, origin, GAIT)?;
         let dynamic = section.remove("dynamic");
-        let keys: GaitSection = deserialize(section, origin, GAIT)?;
+        // `default` is read by `Gait::configured_default` (the client needs it too).
+        section.remove("default");
+        let GaitSection {} = deserialize(section, origin, GAIT)?;
         let mut config = Self {
-            default: keys.default,
+            default,
             dynamic: None,
         };
         if let Some(dynamic) = dynamic {
@@ -217,12 +228,10 @@ impl GaitConfig {
     }
 }
 
-/// The keys of `[gait]` itself.
-#[derive(Deserialize, Default)]
-#[serde(default, deny_unknown_fields)]
-struct GaitSection {
-    default: Gait,
-}
+/// The keys of `[gait]` itself besides `default` and `dynamic`: none (so any other is refused).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GaitSection {}
 
 fn sub_table(
     value: &toml::Value,

@@ -1,0 +1,94 @@
+//! [`Controller::telemetry`]: the estimate and set-points of the last tick as plain `Copy` data,
+//! for observers (the runtime publishes it on `telemetry` after each tick's command).
+
+use kinematics::ground::{SupportPolygon, sole_corners};
+use kinematics::robot::EndEffector;
+use nalgebra::Isometry3;
+use stance::Gait;
+
+use super::status::{BalanceStatus, ControllerState, Phase};
+use super::{Controller, pose_array};
+
+/// What the controller estimated and aimed at in its last tick (world frame; poses as
+/// `[x, y, z, qx, qy, qz, qw]`, end-effectors in `EndEffector` order).
+#[derive(Clone, Copy, Debug)]
+pub struct ControllerTelemetry {
+    /// Top-level state.
+    pub state: ControllerState,
+    /// Phase of the transition.
+    pub phase: Phase,
+    /// Index of the stance being moved towards.
+    pub stance_index: u32,
+    /// Stances in the sequence.
+    pub stance_count: u32,
+    /// Estimated floating-base pose.
+    pub base: [f64; 7],
+    /// Estimated centre of mass (m).
+    pub com: [f64; 3],
+    /// Estimated end-effector frame poses.
+    pub end_effectors: [[f64; 7]; 4],
+    /// End-effectors in the contact set.
+    pub contacts: [bool; 4],
+    /// Each end-effector's target: its anchor while in contact, else its pose task's set-point,
+    /// `None` without either.
+    pub targets: [Option<[f64; 7]>; 4],
+    /// The CoM x/y set-point while executing.
+    pub com_target: Option<[f64; 2]>,
+    /// Support polygon of the feet in contact (the polygon the CoM constraint uses).
+    pub support: SupportPolygon,
+    /// ZMP and DCM of the dynamic gait (`None` for the static gait).
+    pub balance: Option<BalanceStatus>,
+}
+
+impl Controller {
+    /// The estimate and set-points of the last tick. Plain data; no allocation.
+    pub fn telemetry(&self) -> ControllerTelemetry {
+        let status = &self.status;
+        let targets = self.machine.targets();
+        let mut target_poses = [None; 4];
+        for e in EndEffector::ALL {
+            let i = e as usize;
+            target_poses[i] = if targets.contacts[i] {
+                Some(pose_array(&targets.anchors[i]))
+            } else {
+                targets.end_effectors[i].map(|t| pose_array(&t.pose))
+            };
+        }
+        let executing = status.state == ControllerState::Executing;
+        ControllerTelemetry {
+            state: status.state,
+            phase: status.phase,
+            stance_index: status.stance_index,
+            stance_count: status.stance_count,
+            base: pose_array(&self.configuration.base),
+            com: status.com,
+            end_effectors: self.poses.map(|pose| pose_array(&pose)),
+            contacts: targets.contacts,
+            targets: target_poses,
+            com_target: executing.then(|| [targets.com.x, targets.com.y]),
+            support: self.support_polygon(&targets.contacts, &targets.anchors),
+            balance: (self.machine.gait() == Gait::Dynamic).then_some(status.balance),
+        }
+    }
+
+    /// The convex hull of the sole corners of the feet in contact at their anchors, as the QP's
+    /// CoM constraint builds it.
+    fn support_polygon(
+        &self,
+        contacts: &[bool; 4],
+        anchors: &[Isometry3<f64>; 4],
+    ) -> SupportPolygon {
+        let mut corners = [[0.0; 2]; 8];
+        let mut count = 0;
+        for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
+            if !contacts[foot as usize] {
+                continue;
+            }
+            for corner in sole_corners(&anchors[foot as usize], &self.robot.sole) {
+                corners[count] = [corner.x, corner.y];
+                count += 1;
+            }
+        }
+        SupportPolygon::from_points(&corners[..count])
+    }
+}

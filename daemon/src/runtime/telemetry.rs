@@ -1,0 +1,110 @@
+//! Fills the `telemetry` message of a control tick from the controller's
+//! [`ControllerTelemetry`](crate::controller::ControllerTelemetry) and the loop's bookkeeping.
+//! Allocation-free: it runs on the control thread, after the tick's command was sent.
+
+use shm_types::{Code, DaemonState, Flag, SUPPORT_VERTICES, Telemetry, WalkPhase};
+
+use crate::controller::{ControllerTelemetry, Phase};
+
+/// The loop's side of one tick's telemetry.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct TickRecord {
+    /// Telemetry sequence number (1, 2, …).
+    pub seq: u64,
+    /// Ticks executed, this one included.
+    pub tick: u64,
+    /// The answered sample's `seq` and time stamp.
+    pub sample_seq: u64,
+    pub sample_timestamp_ns: u64,
+    /// The command sent this tick (0: none).
+    pub command_seq: u64,
+    /// When the command went out (or the tick ended).
+    pub sent_ns: u64,
+    /// Controller compute time (ns).
+    pub compute_ns: u64,
+    /// Deadline misses so far.
+    pub deadline_misses: u64,
+    /// The daemon's state after the tick.
+    pub state: DaemonState,
+}
+
+/// Writes `record` and `controller` into `out` (every field, so a reused buffer keeps nothing
+/// stale).
+pub(super) fn fill(out: &mut Telemetry, record: &TickRecord, controller: &ControllerTelemetry) {
+    out.seq = record.seq;
+    out.tick = record.tick;
+    out.sample_seq = record.sample_seq;
+    out.sample_timestamp_ns = record.sample_timestamp_ns;
+    out.command_seq = record.command_seq;
+    out.sent_ns = record.sent_ns;
+    out.compute_ns = record.compute_ns;
+    out.deadline_misses = record.deadline_misses;
+    out.state = Code::new(record.state);
+    out.phase = Code::new(wire_phase(controller.phase));
+    out.stance_index = controller.stance_index;
+    out.stance_count = controller.stance_count;
+    out.base = controller.base;
+    out.com = controller.com;
+    out.end_effectors = controller.end_effectors;
+    for (i, target) in controller.targets.iter().enumerate() {
+        out.target_set[i] = Flag::new(target.is_some());
+        out.targets[i] = target.unwrap_or(controller.end_effectors[i]);
+        out.contacts[i] = Flag::new(controller.contacts[i]);
+    }
+    out.com_target_set = Flag::new(controller.com_target.is_some());
+    out.com_target = controller.com_target.unwrap_or([0.0; 2]);
+    let vertices = controller.support.vertices();
+    let count = vertices.len().min(SUPPORT_VERTICES);
+    out.support[..count].copy_from_slice(&vertices[..count]);
+    out.support[count..].fill([0.0; 2]);
+    out.support_count = count as u32;
+    let balance = controller.balance.unwrap_or_default();
+    out.dynamics_valid = Flag::new(controller.balance.is_some());
+    out.zmp_reference = balance.zmp_reference;
+    out.zmp_measured = balance.zmp_measured;
+    out.dcm_reference = balance.dcm_reference;
+    out.dcm_measured = balance.dcm_measured;
+}
+
+/// The wire code of a controller phase.
+fn wire_phase(phase: Phase) -> WalkPhase {
+    match phase {
+        Phase::None => WalkPhase::None,
+        Phase::ShiftCom => WalkPhase::ShiftCom,
+        Phase::Unload => WalkPhase::Unload,
+        Phase::Lift => WalkPhase::Lift,
+        Phase::Swing => WalkPhase::Swing,
+        Phase::Lower => WalkPhase::Lower,
+        Phase::Reach => WalkPhase::Reach,
+        Phase::Settle => WalkPhase::Settle,
+        Phase::DoubleSupport => WalkPhase::DoubleSupport,
+        Phase::SingleSupport => WalkPhase::SingleSupport,
+        Phase::LateTouchdown => WalkPhase::LateTouchdown,
+        Phase::LateLiftOff => WalkPhase::LateLiftOff,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_phase_has_the_wire_code_of_its_name() {
+        for phase in [
+            Phase::None,
+            Phase::ShiftCom,
+            Phase::Unload,
+            Phase::Lift,
+            Phase::Swing,
+            Phase::Lower,
+            Phase::Reach,
+            Phase::Settle,
+            Phase::DoubleSupport,
+            Phase::SingleSupport,
+            Phase::LateTouchdown,
+            Phase::LateLiftOff,
+        ] {
+            assert_eq!(wire_phase(phase).name(), phase.name());
+        }
+    }
+}
