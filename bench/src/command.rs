@@ -12,17 +12,17 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
-use daemon::controller::{Controller, ControllerConfig, ControllerState, SolverKind};
+use daemon::controller::{Controller, ControllerConfig, ControllerState, GaitConfig, SolverKind};
 use daemon::qp::{ClarabelSolver, DenseActiveSetSolver, QpSolver, export_json};
 use hdrhistogram::Histogram;
 use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::RuntimeConfig;
 use stance::learned::SourceArgs;
-use stance::{AffordanceSet, PostProcessParams, PostProcessedSequence, WalkRequest};
+use stance::{AffordanceSet, Gait, PostProcessParams, PostProcessedSequence, WalkRequest};
 
 use crate::sequence;
-use crate::walk::{Outcome, WalkOptions, WalkReport, walk};
+use crate::walk::{Outcome, WalkOptions, WalkReport, kinematic_gaits, walk};
 
 /// Control rate when neither `--rate-hz` nor `[runtime] rate_hz` gives one (Hz).
 const DEFAULT_RATE_HZ: f64 = 500.0;
@@ -86,6 +86,11 @@ pub struct BenchArgs {
     /// Seed of the stance generator (synthetic, or learned without --beam).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Gait: static or dynamic (default: the config's `[gait] default`). A generated walk is
+    /// post-processed with its limits. The dynamic gait is judged by its ZMP, with the
+    /// stabilizer parts that need forces and inertia off (`walk_bench::kinematic_gaits`).
+    #[arg(long)]
+    pub gait: Option<Gait>,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -127,8 +132,10 @@ fn run(args: &BenchArgs) -> anyhow::Result<bool> {
         Robot::from_config(&file, args.urdf.as_deref())
             .with_context(|| format!("loading robot {}", args.robot.display()))?,
     );
-    let params = PostProcessParams::from_config(&file)?;
+    let gait = Gait::chosen_or_configured(args.gait, &file)?;
+    let params = PostProcessParams::from_config_for(&file, gait)?;
     let config = ControllerConfig::from_config(&file)?;
+    let gaits = kinematic_gaits(GaitConfig::from_config(&file)?);
     let rate_hz = match (args.rate_hz, file.section("runtime")) {
         (Some(rate), _) => rate,
         (None, Some(section)) => {
@@ -146,6 +153,8 @@ fn run(args: &BenchArgs) -> anyhow::Result<bool> {
         solver: solver_kind,
         rate_hz,
         time_limit_s: 60.0 + 20.0 * sequence.len() as f64,
+        gait,
+        gaits,
     };
     let mut timing = Timing::new()?;
     let mut timing_solver: Box<dyn QpSolver> = match solver_kind {
@@ -183,15 +192,7 @@ fn run(args: &BenchArgs) -> anyhow::Result<bool> {
         std::fs::write(path, serde_json::to_string(&exported)?)
             .with_context(|| format!("writing {}", path.display()))?;
     }
-    print_report(
-        args,
-        &robot,
-        &origin,
-        solver_kind,
-        rate_hz,
-        &report,
-        &timing,
-    );
+    print_report(args, &robot, &origin, &options, &report, &timing);
     Ok(report.outcome == Outcome::Done)
 }
 
@@ -264,6 +265,7 @@ impl Quantiles {
 #[derive(serde::Serialize)]
 struct JsonReport {
     outcome: String,
+    gait: &'static str,
     stances: usize,
     ticks: u64,
     tick_us: Quantiles,
@@ -278,15 +280,16 @@ fn print_report(
     args: &BenchArgs,
     robot: &Robot,
     origin: &str,
-    solver: SolverKind,
-    rate_hz: f64,
+    options: &WalkOptions,
     report: &WalkReport,
     timing: &Timing,
 ) {
     let safety = &report.safety;
+    let rate_hz = options.rate_hz;
     if args.json {
         let value = JsonReport {
             outcome: report.outcome.label(),
+            gait: options.gait.name(),
             stances: report.stances,
             ticks: report.ticks,
             tick_us: Quantiles::of(&timing.tick),
@@ -303,10 +306,11 @@ fn print_report(
         return;
     }
     println!(
-        "walk-bench: {} ({}), {origin}, solver {}, {} Hz",
+        "walk-bench: {} ({}), {origin}, {} gait, solver {}, {} Hz",
         robot.name,
         args.robot.display(),
-        solver.name(),
+        options.gait.name(),
+        options.solver.name(),
         rate_hz
     );
     println!("  outcome                {}", report.outcome.label());
@@ -325,8 +329,12 @@ fn print_report(
             micros(h, 1.0)
         );
     }
+    let judged = match options.gait {
+        Gait::Static => "CoM",
+        Gait::Dynamic => "ZMP",
+    };
     println!(
-        "  min stability margin   {:.4} m",
+        "  min stability margin   {:.4} m ({judged} to the support polygon)",
         safety.min_stability_margin
     );
     println!("  max contact slip       {:.6} m", safety.max_contact_slip);

@@ -27,4 +27,6 @@ pub mod sequence;
 pub mod walk;
 
 pub use closed_loop::{ClosedLoop, TickError};
-pub use walk::{Outcome, TickObservation, WalkError, WalkOptions, WalkReport, walk};
+pub use walk::{
+    Outcome, TickObservation, WalkError, WalkOptions, WalkReport, kinematic_gaits, walk,
+};

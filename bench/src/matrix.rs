@@ -9,10 +9,10 @@ use std::process::ExitCode;
 use std::sync::Mutex;
 
 use anyhow::Context;
-use daemon::controller::{Gait, GaitConfig};
+
 use kinematics::ConfigFile;
 use serde::Serialize;
-use stance::{AffordanceSet, WalkRequest};
+use stance::{AffordanceSet, Gait, WalkRequest};
 
 use crate::physics::{PhysicsWalkOptions, PhysicsWalkReport, Push, walk_distance};
 
@@ -217,10 +217,7 @@ fn run(args: &MatrixArgs) -> anyhow::Result<MatrixReport> {
     for assignment in &args.overrides {
         config.set(assignment)?;
     }
-    let gait = match args.gait {
-        Some(gait) => gait,
-        None => GaitConfig::from_config(&config)?.default,
-    };
+    let gait = Gait::chosen_or_configured(args.gait, &config)?;
     let options = walk_options(args, gait)?;
     let robot_name = config
         .section("robot")

@@ -1,14 +1,15 @@
 //! A walk to its end against the kinematic simulator, as fast as the machine runs: the closed
 //! loop ([`ClosedLoop`]) until `done`, a fault, a fall (the simulated CoM left the support
-//! polygon) or the time limit.
+//! polygon; for the dynamic gait its ZMP, `SimOptions::judge_by_zmp`) or the time limit.
 
 use kinematic_sim::Simulator;
 use std::sync::Arc;
 
 use daemon::controller::{
-    Command, Controller, ControllerConfig, ControllerState, ControllerStatus, SolverKind,
+    Command, Controller, ControllerConfig, ControllerState, ControllerStatus, Gait, GaitConfig,
+    SolverKind,
 };
-use kinematic_sim::{KinematicSim, SafetySummary, SimMeasurement};
+use kinematic_sim::{KinematicSim, SafetySummary, SimMeasurement, SimOptions};
 use kinematics::robot::Robot;
 use stance::PostProcessedSequence;
 
@@ -23,6 +24,35 @@ pub struct WalkOptions {
     pub rate_hz: f64,
     /// Simulated time after which an unfinished walk is stopped (s).
     pub time_limit_s: f64,
+    /// The gait walked.
+    pub gait: Gait,
+    /// Its `[gait]` tuning (for the dynamic gait, see [`kinematic_gaits`]).
+    pub gaits: GaitConfig,
+}
+
+impl Default for WalkOptions {
+    /// The static gait with the dense solver at 500 Hz for at most 120 s.
+    fn default() -> Self {
+        Self {
+            solver: SolverKind::Dense,
+            rate_hz: 500.0,
+            time_limit_s: 120.0,
+            gait: Gait::Static,
+            gaits: GaitConfig::default(),
+        }
+    }
+}
+
+/// A robot's `[gait]` tuning for the kinematic simulator: the stabilizer parts that act on
+/// forces and inertia (foot damping, tilt damping) switched off. An ideal kinematic robot has
+/// neither, its synthetic centre of pressure follows the commanded motion, and with them on the
+/// kinematic dynamic walk's ZMP leaves the support (docs/controller.md).
+pub fn kinematic_gaits(mut gaits: GaitConfig) -> GaitConfig {
+    if let Some(dynamic) = &mut gaits.dynamic {
+        dynamic.stabilizer.foot_damping = false;
+        dynamic.stabilizer.tilt_damping = false;
+    }
+    gaits
 }
 
 /// One closed-loop tick, handed to the observer after the simulator stepped.
@@ -104,10 +134,15 @@ pub fn walk(
     options: &WalkOptions,
     mut observe: impl FnMut(&TickObservation),
 ) -> Result<WalkReport, WalkError> {
-    let prepared = Controller::prepare(&robot, &config, sequence)?;
+    let prepared =
+        Controller::prepare_gait(&robot, &config, &options.gaits, sequence, options.gait)?;
     let stances = prepared.len();
     let controller = Controller::new(robot.clone(), config, options.solver)?;
-    let sim = KinematicSim::new(robot.clone(), robot.standing.clone())
+    let sim_options = SimOptions {
+        judge_by_zmp: options.gait == Gait::Dynamic,
+        ..SimOptions::default()
+    };
+    let sim = KinematicSim::with_options(robot.clone(), robot.standing.clone(), sim_options)
         .map_err(|e| WalkError::Loop(format!("simulator: {e}")))?;
     let mut closed = ClosedLoop::new(controller, sim, options.rate_hz);
     let max_ticks = (options.time_limit_s * options.rate_hz).ceil() as u64;

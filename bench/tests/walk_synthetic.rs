@@ -14,6 +14,7 @@ fn synthetic(robot_name: &str, solver: SolverKind) {
         solver,
         rate_hz: 200.0,
         time_limit_s: 120.0,
+        ..WalkOptions::default()
     };
     let report = walk(robot, config, &sequence, &options, |o| {
         walk_support::check_tick(o)

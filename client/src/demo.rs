@@ -18,6 +18,7 @@ use stance::{Gait, WalkRequest};
 
 use crate::daemon_client::connect_when_fresh;
 use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
+use crate::evaluate::balance::BalanceRecorder;
 use crate::evaluate::truth::{TruthRecorder, Verdict, judged_outcome};
 use crate::observe::{Recorder, RecorderOutcome};
 use crate::process::{Launch, Processes, executable_dir};
@@ -108,6 +109,11 @@ pub struct DemoOutcome {
     /// Largest tilt of the simulated `base_link` since submission (rad); `None` when no
     /// simulator published its truth (e.g. a running walkd driving a real robot).
     pub max_tilt_rad: Option<f64>,
+    /// The gait walked.
+    pub gait: Gait,
+    /// Walking speed: the simulated soles' travel over the simulated time from the first step
+    /// (a sole rising 1 cm) to the end (m/s); `None` without simulator truth or a step.
+    pub speed_m_s: Option<f64>,
     /// The recording, with `--record`.
     pub recording: Option<RecorderOutcome>,
     /// The Fig. 6 plot, with `--plots`.
@@ -137,6 +143,8 @@ impl DemoOutcome {
         serde_json::json!({
             "outcome": self.outcome(),
             "distance_m": self.distance_m,
+            "gait": self.gait.name(),
+            "speed_m_s": self.speed_m_s,
             "stances": self.stances,
             "sim_s": self.sim_s,
             "wall_s": self.wall_s,
@@ -210,10 +218,7 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         .clone()
         .unwrap_or(runtime.service_prefix);
     let robot = std::sync::Arc::new(Robot::from_config(&file, args.urdf.as_deref())?);
-    let gait = match args.gait {
-        Some(gait) => gait,
-        None => Gait::configured_default(&file)?,
-    };
+    let gait = Gait::chosen_or_configured(args.gait, &file)?;
     let sequence = walk_sequence(&robot, &file, args.distance, args.seed, gait)?;
     let (json, stance_count) = (sequence.to_json_string(), sequence.len());
     let mut targets = crate::evaluate::stance_points(&robot, &sequence);
@@ -242,6 +247,9 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         })
         .transpose()?;
     let recorder = TruthRecorder::start(&prefix)?;
+    let balance = (gait == Gait::Dynamic && args.plots.is_some())
+        .then(|| BalanceRecorder::start(&prefix))
+        .transpose()?;
     let start = client.status()?;
     crate::evaluate::align_targets(
         &mut targets,
@@ -276,18 +284,24 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     let recording = observer.map(Recorder::finish).transpose()?;
     let states = recorder.finish()?;
     let verdict = Verdict::of(&states, submitted_ns);
+    let balance = match balance {
+        Some(recorder) => recorder.finish(start.ticks, start.rate_hz)?,
+        None => Vec::new(),
+    };
+    let sim_s = last.ticks.saturating_sub(start.ticks) as f64 / last.rate_hz;
     let plot = match &args.plots {
         Some(dir) => {
             crate::evaluate::pair_with_truth(&mut trace, &status_times, &states);
             std::fs::create_dir_all(dir)?;
             let file = dir.join(format!("fig6-{}.svg", args.robot.name()));
             let title = format!(
-                "{}, {} m, walkctl demo --physics {}",
+                "{}, {} m, walkctl demo --physics {} --gait {}",
                 args.robot.name(),
                 args.distance,
-                args.physics.name()
+                args.physics.name(),
+                gait.name()
             );
-            crate::evaluate::write_fig6(&file, &title, &trace)?;
+            crate::evaluate::write_fig6(&file, &title, &trace, &balance)?;
             Some(file)
         }
         None => None,
@@ -304,8 +318,10 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     Ok(DemoOutcome {
         distance_m: feet_midpoint(&status)[0] - feet_midpoint(&start)[0],
         stances,
-        sim_s: last.ticks.saturating_sub(start.ticks) as f64 / last.rate_hz,
+        sim_s,
         wall_s,
+        gait,
+        speed_m_s: verdict.and_then(|v| v.speed_m_s(sim_s)),
         fell_at_s: verdict.and_then(|v| v.fell_at_s),
         max_tilt_rad: verdict.map(|v| v.max_tilt_rad),
         recording,
@@ -325,11 +341,16 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
             |tilt| format!("{tilt:.3} rad"),
         );
         println!(
-            "outcome: {}\ndistance covered: {:.3} m\nstances executed: {}\n\
+            "outcome: {}\ndistance covered: {:.3} m ({} gait, {})\nstances executed: {}\n\
              simulated {:.2} s in {:.2} s wall (real-time factor {:.1})\n\
              largest base tilt in the simulator: {tilt}\n{}",
             outcome.outcome(),
             outcome.distance_m,
+            outcome.gait.name(),
+            outcome.speed_m_s.map_or_else(
+                || "no step seen".to_owned(),
+                |v| format!("{v:.3} m/s from the first step")
+            ),
             outcome.stances,
             outcome.sim_s,
             outcome.wall_s,

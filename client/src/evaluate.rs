@@ -15,23 +15,27 @@
 //! only): target vs controller state vs simulator over time for the CoM and both feet
 //! ([`write_fig6`] is shared with the in-process physics walk of the `walk-tests` package).
 
+pub(crate) mod balance;
+pub mod fig6;
 pub mod filmstrip;
 pub(crate) mod truth;
+
+pub use fig6::{BalanceSample, write_fig6};
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
+use kinematics::ConfigFile;
 use kinematics::ground::sequence_alignment;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
-use plotters::prelude::*;
 use shm_types::process::Physics;
 use shm_types::{ClockMode, DaemonState, DaemonStatus, SimTruth};
 use stance::poses::FEET;
-use stance::{AffordanceSet, PostProcessedSequence, WalkRequest};
+use stance::{AffordanceSet, Gait, PostProcessedSequence, WalkRequest};
 
 use crate::daemon_client::connect_when_fresh;
 use crate::process::{Launch, executable_dir};
@@ -67,6 +71,10 @@ pub struct EvaluateArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Gait: static or dynamic (default: each robot config's `[gait] default`). The walks are
+    /// post-processed with that gait's limits and ask walkd for it.
+    #[arg(long)]
+    pub gait: Option<Gait>,
     /// Write Fig. 6 per robot (`fig6_<robot>.svg`) into this directory.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
@@ -227,8 +235,17 @@ pub struct RunResult {
     pub stances: usize,
     /// The stance the daemon was moving towards at the end.
     pub stance_reached: u32,
+    /// The gait walked.
+    pub gait: Gait,
+    /// Horizontal distance the simulated soles' midpoint travelled (m).
+    pub walked_m: f64,
+    /// Walking speed: `walked_m` over the simulated time from the first step (a simulated sole
+    /// rising 1 cm) to the end (m/s); `None` if no step was seen.
+    pub speed_m_s: Option<f64>,
     /// The status stream as a Fig. 6 trace.
     pub trace: Vec<TraceSample>,
+    /// A dynamic walk's ZMP and DCM from walkd's telemetry (empty for the static gait).
+    pub balance: Vec<BalanceSample>,
 }
 
 impl RunResult {
@@ -249,6 +266,9 @@ impl RunResult {
             "final_position_error_m": self.final_position_error_m,
             "stances": self.stances,
             "stance_reached": self.stance_reached,
+            "gait": self.gait.name(),
+            "walked_m": self.walked_m,
+            "speed_m_s": self.speed_m_s,
         })
     }
 }
@@ -313,7 +333,7 @@ fn plot_robot(dir: &Path, robot: &str, results: &[RunResult]) -> anyhow::Result<
         result.run,
         result.outcome
     );
-    write_fig6(&file, &title, &result.trace)
+    write_fig6(&file, &title, &result.trace, &result.balance)
 }
 
 /// One run: own processes on an own prefix, submit, record, stop.
@@ -326,7 +346,9 @@ fn run_once(
     distance: f64,
     run: u32,
 ) -> anyhow::Result<RunResult> {
-    let params = stance::PostProcessParams::from_config_path(config)?;
+    let file = ConfigFile::load(config)?;
+    let gait = Gait::chosen_or_configured(args.gait, &file)?;
+    let params = stance::PostProcessParams::from_config_for(&file, gait)?;
     let request = WalkRequest {
         distance,
         affordances,
@@ -372,6 +394,9 @@ fn run_once(
         })
         .transpose()?;
     let recorder = truth::TruthRecorder::start(&prefix)?;
+    let balance = (gait == Gait::Dynamic)
+        .then(|| balance::BalanceRecorder::start(&prefix))
+        .transpose()?;
     let start = client.status()?;
     align_targets(
         &mut targets,
@@ -396,6 +421,10 @@ fn run_once(
         observer.finish()?;
     }
     let states = recorder.finish()?;
+    let balance = match balance {
+        Some(recorder) => recorder.finish(start.ticks, start.rate_hz)?,
+        None => Vec::new(),
+    };
     let [walkd, sim] = processes;
     let walkd_log = walkd.stop()?.log;
     let sim_log = sim.stop()?.log;
@@ -425,6 +454,7 @@ fn run_once(
     let end = Points::from_truth(&verdict.end);
     let final_target = targets[targets.len() - 1];
     let done = last.state == DaemonState::Done;
+    let sim_s = (last.ticks - start.ticks) as f64 / last.rate_hz;
     let daemon_outcome = if done {
         "done".to_owned()
     } else {
@@ -437,7 +467,7 @@ fn run_once(
         run,
         success: done && verdict.fell_at_s.is_none(),
         outcome: truth::judged_outcome(verdict.fell_at_s, &daemon_outcome),
-        sim_s: (last.ticks - start.ticks) as f64 / last.rate_hz,
+        sim_s,
         wall_s,
         final_position_error_m: end.distances(&final_target).1,
         drift_m: drift.map(|(largest, _)| largest),
@@ -446,7 +476,11 @@ fn run_once(
         fell_at_s: verdict.fell_at_s,
         stances: sequence.len(),
         stance_reached: last.stance_index,
+        gait,
+        walked_m: verdict.walked_m,
+        speed_m_s: verdict.speed_m_s(sim_s),
         trace,
+        balance,
     })
 }
 
@@ -489,8 +523,9 @@ pub(crate) fn pair_with_truth(
 
 fn row(r: &RunResult) -> String {
     format!(
-        "{:<8} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) final error {:.4} m drift {} max tilt {:.3} rad stance {}/{}",
+        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{}",
         r.robot,
+        r.gait.name(),
         r.affordances.name(),
         r.distance_m,
         r.run,
@@ -499,6 +534,9 @@ fn row(r: &RunResult) -> String {
         r.sim_s,
         r.wall_s,
         r.sim_s / r.wall_s,
+        r.walked_m,
+        r.speed_m_s
+            .map_or_else(|| "no step".to_owned(), |v| format!("{v:.3} m/s")),
         r.final_position_error_m,
         r.drift_m
             .map_or_else(|| "n/a".to_owned(), |d| format!("{d:.4} m")),
@@ -508,10 +546,11 @@ fn row(r: &RunResult) -> String {
     )
 }
 
-/// Per robot, affordance set and distance: successes, mean simulated and wall time, real-time factor.
+/// Per robot, affordance set and distance: successes, mean simulated and wall time, real-time
+/// factor, and the speed of the successful runs.
 fn summary(results: &[RunResult]) -> String {
     let mut out = String::from(
-        "robot    affordances      distance  success  sim_s(mean)  wall_s(mean)  real-time factor\n",
+        "robot    affordances      distance  success  sim_s(mean)  wall_s(mean)  real-time factor  speed m/s (mean, min)\n",
     );
     let mut groups: Vec<(&str, AffordanceSet, f64)> = Vec::new();
     for r in results {
@@ -531,9 +570,21 @@ fn summary(results: &[RunResult]) -> String {
         let ok = runs.iter().filter(|r| r.success).count();
         let sim: f64 = runs.iter().map(|r| r.sim_s).sum();
         let wall: f64 = runs.iter().map(|r| r.wall_s).sum();
+        let speeds: Vec<f64> = runs
+            .iter()
+            .filter(|r| r.success)
+            .filter_map(|r| r.speed_m_s)
+            .collect();
+        let speed = if speeds.is_empty() {
+            "-".to_owned()
+        } else {
+            let mean = speeds.iter().sum::<f64>() / speeds.len() as f64;
+            let min = speeds.iter().copied().fold(f64::INFINITY, f64::min);
+            format!("{mean:.3}, {min:.3}")
+        };
         let _ = writeln!(
             out,
-            "{robot:<8} {:<16} {distance:>6.1} m  {ok:>3}/{:<3} {:>11.2}  {:>12.2}  {:>16.1}",
+            "{robot:<8} {:<16} {distance:>6.1} m  {ok:>3}/{:<3} {:>11.2}  {:>12.2}  {:>16.1}  {speed}",
             affordances.name(),
             runs.len(),
             sim / n,
@@ -542,100 +593,4 @@ fn summary(results: &[RunResult]) -> String {
         );
     }
     out
-}
-
-/// Writes the paper's Fig. 6: x, y and z over time of the CoM and both soles — target (dashed),
-/// controller estimate (solid) and, where present, the simulator's truth (dotted) — nine panels.
-pub fn write_fig6(file: &Path, title: &str, trace: &[TraceSample]) -> anyhow::Result<()> {
-    draw_fig6(file, title, trace)
-        .map_err(|e| anyhow::anyhow!("{}: cannot draw Fig. 6: {e}", file.display()))
-}
-
-type DrawResult = Result<(), Box<dyn std::error::Error>>;
-/// Picks one of the three plotted points.
-type PointOf = fn(&Points) -> Vector3<f64>;
-
-fn draw_fig6(file: &Path, title: &str, trace: &[TraceSample]) -> DrawResult {
-    let root = SVGBackend::new(file, (1500, 900)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let root = root.titled(title, ("sans-serif", 20))?;
-    let end = trace.last().map_or(1.0, |s| s.t.max(1e-3));
-    let series: [(&str, PointOf); 3] = [
-        ("CoM", |p| p.com),
-        ("left foot", |p| p.left_foot),
-        ("right foot", |p| p.right_foot),
-    ];
-    for (r, row_area) in root.split_evenly((3, 1)).iter().enumerate() {
-        let (name, point) = series[r];
-        for (axis, area) in row_area.split_evenly((1, 3)).iter().enumerate() {
-            let value = |p: &Points| point(p)[axis];
-            let values = trace.iter().flat_map(|s| {
-                [
-                    Some(value(&s.target)),
-                    Some(value(&s.controller)),
-                    s.sim.as_ref().map(value),
-                ]
-                .into_iter()
-                .flatten()
-            });
-            let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(v), hi.max(v))
-            });
-            let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 1.0) };
-            let margin = ((hi - lo) * 0.1).max(0.005);
-            let mut chart = ChartBuilder::on(area)
-                .caption(
-                    format!("{name} {}", ["x", "y", "z"][axis]),
-                    ("sans-serif", 14),
-                )
-                .margin(6)
-                .x_label_area_size(28)
-                .y_label_area_size(52)
-                .build_cartesian_2d(0.0..end, lo - margin..hi + margin)?;
-            chart
-                .configure_mesh()
-                .x_desc("t (s)")
-                .y_desc("m")
-                .light_line_style(WHITE)
-                .draw()?;
-            let line = |get: &dyn Fn(&TraceSample) -> Option<f64>| -> Vec<(f64, f64)> {
-                trace
-                    .iter()
-                    .filter_map(|s| get(s).map(|v| (s.t, v)))
-                    .collect()
-            };
-            chart
-                .draw_series(DashedLineSeries::new(
-                    line(&|s| Some(value(&s.target))),
-                    6,
-                    4,
-                    RED.stroke_width(2),
-                ))?
-                .label("target")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED));
-            chart
-                .draw_series(LineSeries::new(
-                    line(&|s| Some(value(&s.controller))),
-                    BLUE.stroke_width(2),
-                ))?
-                .label("controller")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLUE));
-            let sim = line(&|s| s.sim.as_ref().map(value));
-            if !sim.is_empty() {
-                chart
-                    .draw_series(DashedLineSeries::new(sim, 2, 3, GREEN.stroke_width(2)))?
-                    .label("simulator")
-                    .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], GREEN));
-            }
-            if r == 0 && axis == 0 {
-                chart
-                    .configure_series_labels()
-                    .background_style(WHITE.mix(0.8))
-                    .border_style(BLACK)
-                    .draw()?;
-            }
-        }
-    }
-    root.present()?;
-    Ok(())
 }

@@ -4,13 +4,19 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use stance::plot::{Snapshot, write_fig3};
-use stance::{ContactUnification, PostProcessParams, PostProcessor, RawSequence};
+use stance::{ContactUnification, Gait, PostProcessParams, PostProcessor, RawSequence};
 
 /// Command-line overrides of the config's `[postprocess]` values.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct ParamOverrides {
+    /// The gait whose limits to start from (`[postprocess]`, or with the dynamic gait's
+    /// `[postprocess.dynamic]` overrides); the output asks walkd for that gait. Default: the
+    /// config's `[gait] default`.
+    #[arg(long)]
+    pub gait: Option<Gait>,
     /// Sequence scaling factor (0, 1].
     #[arg(long)]
     pub scf: Option<f64>,
@@ -52,9 +58,11 @@ fn parse_unification(s: &str) -> Result<ContactUnification, String> {
 }
 
 impl ParamOverrides {
-    /// The config's `[postprocess]` parameters with these overrides applied and re-validated.
+    /// The config's parameters for the gait, with these overrides applied and re-validated.
     pub fn load(&self, config: &Path) -> anyhow::Result<PostProcessParams> {
-        let mut p = PostProcessParams::from_config_path(config)?;
+        let file = ConfigFile::load(config)?;
+        let gait = Gait::chosen_or_configured(self.gait, &file)?;
+        let mut p = PostProcessParams::from_config_for(&file, gait)?;
         let fields = [
             (self.scf, &mut p.scf),
             (self.s_max, &mut p.s_max),

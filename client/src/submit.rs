@@ -1,9 +1,13 @@
-//! `walkctl submit FILE [--postprocess]`: send a stance sequence to a running `walkd`.
+//! `walkctl submit FILE [--postprocess] [--gait static|dynamic]`: send a stance sequence to a
+//! running `walkd`, walked with the gait the file names (or `--gait`), else the robot config's
+//! `[gait] default`.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
+use kinematics::ConfigFile;
 use kinematics::robot::Robot;
+use stance::Gait;
 
 use crate::daemon_client::{DaemonClient, DaemonTarget, read_text};
 
@@ -18,21 +22,35 @@ pub struct SubmitArgs {
     /// URDF overriding the config's (with --postprocess).
     #[arg(long)]
     pub urdf: Option<PathBuf>,
+    /// Gait to walk with, replacing the one the file names. With --postprocess: also the limits
+    /// it is post-processed with (default there: the config's `[gait] default`).
+    #[arg(long)]
+    pub gait: Option<Gait>,
     #[command(flatten)]
     pub target: DaemonTarget,
 }
 
-/// Post-processes a raw sequence file's text for the robot of `config`.
-pub fn postprocess_text(
+/// Post-processes a raw sequence file's text for the robot of `config` with the limits of
+/// `gait` (default: the config's `[gait] default`).
+fn postprocess_text(
     text: &str,
     config: &std::path::Path,
     urdf: Option<&std::path::Path>,
+    gait: Option<Gait>,
 ) -> anyhow::Result<String> {
-    let robot = Robot::load(config, urdf)?;
+    let file = ConfigFile::load(config)?;
+    let robot = Robot::from_config(&file, urdf)?;
     let raw = stance::RawSequence::from_json_str(text, &robot)?;
-    let params = stance::PostProcessParams::from_config_path(config)?;
+    let gait = Gait::chosen_or_configured(gait, &file)?;
+    let params = stance::PostProcessParams::from_config_for(&file, gait)?;
     let processed = stance::PostProcessor::new(&robot, params).process(&raw)?;
     Ok(processed.to_json_string())
+}
+
+/// A post-processed file's text asking for `gait` instead of the gait it names.
+fn with_gait(text: &str, gait: Gait) -> anyhow::Result<String> {
+    let sequence = stance::PostProcessedSequence::parse_json_str(text)?;
+    Ok(sequence.with_gait(Some(gait)).to_json_string())
 }
 
 /// Submits the file; prints the sequence id, or fails with the daemon's reason.
@@ -43,8 +61,11 @@ pub fn run(args: &SubmitArgs) -> anyhow::Result<()> {
             args.target.config.as_deref().context(
                 "--postprocess needs --config CONFIG (robot and [postprocess] parameters)",
             )?;
-        json = postprocess_text(&json, config, args.urdf.as_deref())
+        json = postprocess_text(&json, config, args.urdf.as_deref(), args.gait)
             .with_context(|| format!("post-processing {}", args.file.display()))?;
+    } else if let Some(gait) = args.gait {
+        json =
+            with_gait(&json, gait).with_context(|| format!("reading {}", args.file.display()))?;
     }
     let client = DaemonClient::connect(&args.target.prefix()?)?;
     let id = client.submit_json(&json)?;

@@ -264,6 +264,8 @@ pub struct KinematicSim {
     last_dt: f64,
     /// The filtered CoM acceleration.
     com_acceleration: Vector3<f64>,
+    /// Where the ground reaction acted in the last step (see `resultant`).
+    support_point: Vector3<f64>,
 }
 
 impl KinematicSim {
@@ -304,7 +306,9 @@ impl KinematicSim {
             com_history: [None; 2],
             last_dt: 0.0,
             com_acceleration: Vector3::zeros(),
+            support_point: Vector3::zeros(),
         };
+        sim.support_point = sim.kinematics.com();
         let mut lowest = f64::INFINITY;
         for (slot, foot) in FEET.iter().enumerate() {
             let height = sim.lowest_corner_height(*foot);
@@ -368,7 +372,15 @@ impl KinematicSim {
         // out as the foot is lifted towards release: the foot the CoM stands over stays put, a
         // foot pressed into the ground beside it only penetrates, and a foot being unloaded
         // stops dragging the base (and so the other foot) before it leaves the ground.
-        let mut shares = self.lever_shares(&self.kinematics.com());
+        // The weight acts at the ground reaction's point of the last step: the CoM's projection,
+        // or with `judge_by_zmp` the ZMP (a dynamic walk's CoM passes between the feet while the
+        // ZMP stays under the stance foot, and a swing foot touching down carries nothing yet).
+        let point = if self.options.judge_by_zmp {
+            self.support_point
+        } else {
+            self.kinematics.com()
+        };
+        let mut shares = self.lever_shares(&point);
         for (slot, foot) in FEET.iter().enumerate() {
             if let Some(anchor) = self.anchors[slot] {
                 let lift = self.pose(*foot).translation.z - anchor.translation.z;
@@ -460,6 +472,7 @@ impl KinematicSim {
     fn finish_step(&mut self, limit_violations: usize, dt: f64) {
         let com = self.kinematics.com();
         let (support_point, weight) = self.resultant(&com, dt);
+        self.support_point = support_point;
         let shares = self.lever_shares(&support_point);
         let mut loads = [0.0; 2];
         let mut slip: f64 = 0.0;

@@ -41,6 +41,17 @@ impl Gait {
         }
     }
 
+    /// `choice`, or the config's `[gait] default` when the user made none.
+    pub fn chosen_or_configured(
+        choice: Option<Self>,
+        file: &ConfigFile,
+    ) -> Result<Self, ParamsError> {
+        match choice {
+            Some(gait) => Ok(gait),
+            None => Self::configured_default(file),
+        }
+    }
+
     /// `[gait] default` of a robot config: the gait of a walk that does not ask for one
     /// (static when absent). Read here because both sides need it: the client post-processes
     /// with that gait's limits, the daemon walks a file that names no gait with it. The rest of

@@ -30,11 +30,9 @@ pub fn robot(name: &str) -> Arc<Robot> {
 /// stabilizer that need forces and inertia (foot damping, tilt damping) switched off, as an ideal
 /// kinematic robot has neither: its synthetic centre of pressure follows the commanded motion.
 pub fn kinematic_gait_config(name: &str) -> GaitConfig {
-    let mut gaits = GaitConfig::from_config_file(&config_path(name)).expect("gait config parses");
-    let stabilizer = &mut gaits.dynamic.as_mut().expect("a dynamic gait").stabilizer;
-    stabilizer.foot_damping = false;
-    stabilizer.tilt_damping = false;
-    gaits
+    let gaits = GaitConfig::from_config_file(&config_path(name)).expect("gait config parses");
+    assert!(gaits.dynamic.is_some(), "{name} has a dynamic gait");
+    walk_bench::kinematic_gaits(gaits)
 }
 
 /// The `[controller]` section of `name`'s config.
@@ -154,6 +152,7 @@ pub fn assert_walks_to_done(
         solver,
         rate_hz,
         time_limit_s: 60.0 + 20.0 * sequence.len() as f64,
+        ..WalkOptions::default()
     };
     let mut last = (0, Phase::None);
     let report = walk(

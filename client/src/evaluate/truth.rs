@@ -88,6 +88,23 @@ pub(crate) struct Verdict {
     pub(crate) fell_at_s: Option<f64>,
     /// Largest `base_link` tilt from the vertical since submission (rad).
     pub(crate) max_tilt_rad: f64,
+    /// Simulated time from submission at which a sole first rose [`STEP_HEIGHT_M`] above its
+    /// height at submission: the first step (s).
+    pub(crate) first_step_s: Option<f64>,
+    /// Horizontal distance the midpoint of the soles travelled from submission to the end (m).
+    pub(crate) walked_m: f64,
+}
+
+/// How far a sole must rise for the walk to have stepped (m): above the contact compliance,
+/// below the lowest swing (`h_min`).
+pub(crate) const STEP_HEIGHT_M: f64 = 0.01;
+
+/// The horizontal midpoint of the two simulated soles.
+fn feet_midpoint(state: &SimTruth) -> [f64; 2] {
+    [
+        (state.left_foot[0] + state.right_foot[0]) / 2.0,
+        (state.left_foot[1] + state.right_foot[1]) / 2.0,
+    ]
 }
 
 impl Verdict {
@@ -95,7 +112,16 @@ impl Verdict {
     pub(crate) fn of(states: &[SimTruth], submitted_ns: u64) -> Option<Self> {
         let end = *states.last()?;
         let since_submission = || states.iter().filter(|s| s.timestamp_ns >= submitted_ns);
-        let submitted_at = state_at(states, submitted_ns).map_or(0.0, |s| s.sim_time_s);
+        let at_submission = state_at(states, submitted_ns).unwrap_or(&states[0]);
+        let submitted_at = at_submission.sim_time_s;
+        let (left_z, right_z) = (at_submission.left_foot[2], at_submission.right_foot[2]);
+        let first_step_s = since_submission()
+            .find(|s| {
+                s.left_foot[2] > left_z + STEP_HEIGHT_M || s.right_foot[2] > right_z + STEP_HEIGHT_M
+            })
+            .map(|s| s.sim_time_s - submitted_at);
+        let (start, finish) = (feet_midpoint(at_submission), feet_midpoint(&end));
+        let walked_m = (finish[0] - start[0]).hypot(finish[1] - start[1]);
         // The flag is sticky: the end state says whether a fall happened at all, even if the
         // state where it first fired was lost.
         let fell_at_s = end.fallen.is_set().then(|| {
@@ -106,7 +132,17 @@ impl Verdict {
             end,
             fell_at_s,
             max_tilt_rad: since_submission().map(|s| s.tilt_rad).fold(0.0, f64::max),
+            first_step_s,
+            walked_m,
         })
+    }
+
+    /// The walking speed of a walk that ended `walk_s` after submission: the distance walked
+    /// over the time from the first step to the end (m/s); `None` without a step before it.
+    pub(crate) fn speed_m_s(&self, walk_s: f64) -> Option<f64> {
+        self.first_step_s
+            .filter(|first| *first < walk_s)
+            .map(|first| self.walked_m / (walk_s - first))
     }
 }
 
@@ -198,5 +234,41 @@ mod verdict_tests {
             "fault: timeout"
         );
         assert_eq!(Verdict::of(&[], 0), None);
+    }
+}
+
+#[cfg(test)]
+mod step_tests {
+    use super::*;
+
+    /// A state at `t` s with the left sole at (x, 0, left_z) and the right one at (x, -0.2, 0).
+    fn state(seq: u64, x: f64, left_z: f64) -> SimTruth {
+        let mut state = SimTruth {
+            seq,
+            timestamp_ns: seq * 1000,
+            sim_time_s: seq as f64 * 0.1,
+            ..SimTruth::ZERO
+        };
+        state.left_foot[..3].copy_from_slice(&[x, 0.0, left_z]);
+        state.right_foot[..3].copy_from_slice(&[x, -0.2, 0.0]);
+        state
+    }
+
+    #[test]
+    fn the_first_step_is_a_sole_rising_above_its_height_at_submission() {
+        let states = [
+            state(1, 0.0, 0.0),
+            state(2, 0.0, 0.005),
+            state(3, 0.0, 0.02),
+            state(4, 0.3, 0.0),
+            state(5, 0.4, 0.0),
+        ];
+        let verdict = Verdict::of(&states, 1000).unwrap();
+        assert!((verdict.first_step_s.unwrap() - 0.2).abs() < 1e-12);
+        assert!((verdict.walked_m - 0.4).abs() < 1e-12);
+        assert!((verdict.speed_m_s(1.2).unwrap() - 0.4).abs() < 1e-12);
+        assert_eq!(verdict.speed_m_s(0.1), None);
+        let standing = [state(1, 0.0, 0.0), state(2, 0.0, 0.004)];
+        assert_eq!(Verdict::of(&standing, 1000).unwrap().first_step_s, None);
     }
 }

@@ -1,0 +1,186 @@
+//! The paper's Fig. 6 for one walk: x, y and z over time of the CoM and both soles — target
+//! (dashed), controller estimate (solid) and, where known, the simulator's truth (dotted). A
+//! dynamic walk adds a row for its balance: the walking pattern's ZMP and DCM against the
+//! measured ones, x and y.
+
+use std::path::Path;
+
+use nalgebra::Vector3;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{Points, TraceSample};
+
+/// The balance of a dynamic walk at one instant (world x, y; m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BalanceSample {
+    /// Time since the walk started (s).
+    pub t: f64,
+    /// The walking pattern's ZMP.
+    pub zmp_reference: [f64; 2],
+    /// The ZMP from the ankle wrenches (NaN while the feet carry too little).
+    pub zmp_measured: [f64; 2],
+    /// The walking pattern's DCM.
+    pub dcm_reference: [f64; 2],
+    /// The DCM of the estimated CoM.
+    pub dcm_measured: [f64; 2],
+}
+
+/// Writes Fig. 6 of `trace` (and the balance row of `balance`, when it has samples) as SVG.
+pub fn write_fig6(
+    file: &Path,
+    title: &str,
+    trace: &[TraceSample],
+    balance: &[BalanceSample],
+) -> anyhow::Result<()> {
+    draw(file, title, trace, balance)
+        .map_err(|e| anyhow::anyhow!("{}: cannot draw Fig. 6: {e}", file.display()))
+}
+
+type DrawResult = Result<(), Box<dyn std::error::Error>>;
+/// Picks one of the three plotted points.
+type PointOf = fn(&Points) -> Vector3<f64>;
+/// A panel's area.
+type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+
+/// One plotted line: its points, dashed or not, colour and legend label.
+struct Line {
+    points: Vec<(f64, f64)>,
+    dashed: bool,
+    colour: RGBColor,
+    label: &'static str,
+}
+
+fn draw(file: &Path, title: &str, trace: &[TraceSample], balance: &[BalanceSample]) -> DrawResult {
+    let rows = if balance.is_empty() { 3 } else { 4 };
+    let root = SVGBackend::new(file, (1500, 300 * rows as u32)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 20))?;
+    let end = trace.last().map_or(1.0, |s| s.t.max(1e-3));
+    let series: [(&str, PointOf); 3] = [
+        ("CoM", |p| p.com),
+        ("left foot", |p| p.left_foot),
+        ("right foot", |p| p.right_foot),
+    ];
+    let row_areas = root.split_evenly((rows, 1));
+    for (r, row_area) in row_areas.iter().take(3).enumerate() {
+        let (name, point) = series[r];
+        for (axis, area) in row_area.split_evenly((1, 3)).iter().enumerate() {
+            let value = |p: &Points| point(p)[axis];
+            let line = |get: &dyn Fn(&TraceSample) -> Option<f64>| -> Vec<(f64, f64)> {
+                trace
+                    .iter()
+                    .filter_map(|s| get(s).map(|v| (s.t, v)))
+                    .collect()
+            };
+            let lines = [
+                Line {
+                    points: line(&|s| Some(value(&s.target))),
+                    dashed: true,
+                    colour: RED,
+                    label: "target",
+                },
+                Line {
+                    points: line(&|s| Some(value(&s.controller))),
+                    dashed: false,
+                    colour: BLUE,
+                    label: "controller",
+                },
+                Line {
+                    points: line(&|s| s.sim.as_ref().map(value)),
+                    dashed: true,
+                    colour: GREEN,
+                    label: "simulator",
+                },
+            ];
+            let caption = format!("{name} {}", ["x", "y", "z"][axis]);
+            panel(area, &caption, end, &lines, r == 0 && axis == 0)?;
+        }
+    }
+    if let Some(row_area) = row_areas.get(3) {
+        for (axis, area) in row_area.split_evenly((1, 2)).iter().enumerate() {
+            let line = |get: fn(&BalanceSample) -> [f64; 2]| -> Vec<(f64, f64)> {
+                balance
+                    .iter()
+                    .map(|s| (s.t, get(s)[axis]))
+                    .filter(|(_, v)| v.is_finite())
+                    .collect()
+            };
+            let orange = RGBColor(230, 140, 0);
+            let lines = [
+                Line {
+                    points: line(|s| s.zmp_reference),
+                    dashed: true,
+                    colour: RED,
+                    label: "ZMP reference",
+                },
+                Line {
+                    points: line(|s| s.zmp_measured),
+                    dashed: false,
+                    colour: BLUE,
+                    label: "ZMP measured",
+                },
+                Line {
+                    points: line(|s| s.dcm_reference),
+                    dashed: true,
+                    colour: orange,
+                    label: "DCM reference",
+                },
+                Line {
+                    points: line(|s| s.dcm_measured),
+                    dashed: false,
+                    colour: MAGENTA,
+                    label: "DCM measured",
+                },
+            ];
+            let caption = format!("ZMP and DCM {}", ["x", "y"][axis]);
+            panel(area, &caption, end, &lines, axis == 0)?;
+        }
+    }
+    root.present()?;
+    Ok(())
+}
+
+/// One panel of `lines` over `0..end` s, with the legend if `legend`.
+fn panel(area: &Area, caption: &str, end: f64, lines: &[Line], legend: bool) -> DrawResult {
+    let (lo, hi) = lines
+        .iter()
+        .flat_map(|line| line.points.iter().map(|(_, v)| *v))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 1.0) };
+    let margin = ((hi - lo) * 0.1).max(0.005);
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 14))
+        .margin(6)
+        .x_label_area_size(28)
+        .y_label_area_size(52)
+        .build_cartesian_2d(0.0..end, lo - margin..hi + margin)?;
+    chart
+        .configure_mesh()
+        .x_desc("t (s)")
+        .y_desc("m")
+        .light_line_style(WHITE)
+        .draw()?;
+    for line in lines.iter().filter(|line| !line.points.is_empty()) {
+        let colour = line.colour;
+        let style = colour.stroke_width(2);
+        let drawn = if line.dashed {
+            chart.draw_series(DashedLineSeries::new(line.points.clone(), 6, 4, style))?
+        } else {
+            chart.draw_series(LineSeries::new(line.points.clone(), style))?
+        };
+        drawn
+            .label(line.label)
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour));
+    }
+    if legend {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
+    }
+    Ok(())
+}
