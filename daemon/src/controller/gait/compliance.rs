@@ -3,9 +3,11 @@
 //! constraints add to their hold.
 //!
 //! The desired ZMP is first split between the feet in contact: in double support by the lever
-//! rule along the line between the sole centres (normal-force shares), each foot's centre of
-//! pressure (CoP) being its centre moved by the desired ZMP's offset from that line, clamped into
-//! the sole; in single support the stance foot carries everything at the desired ZMP.
+//! rule along the line between the feet's single-support ZMP points (the sole centres, moved
+//! towards each other by `zmp_inward_offset_m`), giving normal-force shares, each foot's centre
+//! of pressure (CoP) being its point moved by the desired ZMP's offset from that line, clamped
+//! into the sole; in single support the stance foot carries everything at the desired ZMP. So
+//! the foot about to lift carries nothing once the ZMP has reached the stance foot's point.
 //!
 //! - **Foot damping**: a foot turns about the horizontal axes so that its measured CoP moves to
 //!   the desired one: `ω_x = −A f_z (cop_d − cop_m)_y`, `ω_y = A f_z (cop_d − cop_m)_x` (A in
@@ -24,10 +26,11 @@
 //!   `k K_d θ̇`. The feet in contact turn by `K_d θ̇` relative to the body held by the other tasks,
 //!   at most by a bound (a rigid, kinematic robot would turn its feet with nothing to damp).
 
-use kinematics::robot::SoleRectangle;
+use kinematics::robot::{EndEffector, SoleRectangle};
 use nalgebra::{Isometry3, Point3, Vector2};
 
 use super::config::StabilizerConfig;
+use super::dcm::stance_zmp;
 
 /// What a foot in contact should carry.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,24 +42,26 @@ pub(crate) struct FootLoad {
 }
 
 /// Splits the desired ZMP `zmp` between the feet on the ground (`feet`: left, right sole poses,
-/// `None` in the air), each CoP kept `margin` inside its sole.
+/// `None` in the air), each CoP kept `margin` inside its sole; the lever's ends are `inward` (m)
+/// from the sole centres towards the other foot.
 pub(crate) fn distribute(
     zmp: Vector2<f64>,
     feet: [Option<&Isometry3<f64>>; 2],
     sole: &SoleRectangle,
     margin: f64,
+    inward: f64,
 ) -> [Option<FootLoad>; 2] {
-    let centre = |pose: &Isometry3<f64>| pose.translation.vector.xy();
     match feet {
         [Some(left), Some(right)] => {
-            let (a, b) = (centre(left), centre(right));
+            let a = stance_zmp(left, EndEffector::LeftFoot, inward);
+            let b = stance_zmp(right, EndEffector::RightFoot, inward);
             let line = b - a;
             let t = ((zmp - a).dot(&line) / line.norm_squared()).clamp(0.0, 1.0);
             let offset = zmp - (a + line * t);
-            [(left, 1.0 - t), (right, t)].map(|(pose, share)| {
+            [(left, a, 1.0 - t), (right, b, t)].map(|(pose, point, share)| {
                 Some(FootLoad {
                     share,
-                    cop: clamp_to_sole(centre(pose) + offset, pose, sole, margin),
+                    cop: clamp_to_sole(point + offset, pose, sole, margin),
                 })
             })
         }
@@ -169,7 +174,8 @@ mod tests {
     fn double_support_splits_by_the_lever_rule() {
         let (left, right) = (foot(0.0, 0.1), foot(0.2, -0.1));
         let zmp = Vector2::new(0.05, 0.05);
-        let [Some(l), Some(r)] = distribute(zmp, [Some(&left), Some(&right)], &SOLE, 0.01) else {
+        let [Some(l), Some(r)] = distribute(zmp, [Some(&left), Some(&right)], &SOLE, 0.01, 0.0)
+        else {
             panic!("both feet carry");
         };
         assert!((l.share + r.share - 1.0).abs() < 1e-12);
@@ -180,11 +186,41 @@ mod tests {
     }
 
     #[test]
+    fn with_an_inward_offset_the_stance_point_carries_everything() {
+        let (left, right) = (foot(0.0, 0.1), foot(0.2, -0.1));
+        let inward = 0.02;
+        let feet = [Some(&left), Some(&right)];
+        // The ZMP on the right foot's single-support point: the left foot carries nothing.
+        let point = Vector2::new(0.2, -0.08);
+        let [Some(l), Some(r)] = distribute(point, feet, &SOLE, 0.01, inward) else {
+            panic!("both feet carry");
+        };
+        assert!(l.share.abs() < 1e-12 && (r.share - 1.0).abs() < 1e-12);
+        assert!((r.cop - point).norm() < 1e-12, "{:?}", r.cop);
+        // Without the offset the lever rule between the centres leaves load on the left foot.
+        let [Some(l), _] = distribute(point, feet, &SOLE, 0.01, 0.0) else {
+            panic!("both feet carry");
+        };
+        assert!(l.share > 0.05, "{}", l.share);
+        // Between the points the shares and CoPs still reproduce the ZMP.
+        let zmp = Vector2::new(0.08, 0.02);
+        let [Some(l), Some(r)] = distribute(zmp, feet, &SOLE, 0.01, inward) else {
+            panic!("both feet carry");
+        };
+        let resultant = l.cop * l.share + r.cop * r.share;
+        assert!((resultant - zmp).norm() < 1e-12, "{resultant:?}");
+    }
+
+    #[test]
     fn single_support_carries_all_at_the_zmp_clamped_into_the_sole() {
         let stance = foot(0.0, -0.1);
-        let [None, Some(load)] =
-            distribute(Vector2::new(0.0, 0.0), [None, Some(&stance)], &SOLE, 0.01)
-        else {
+        let [None, Some(load)] = distribute(
+            Vector2::new(0.0, 0.0),
+            [None, Some(&stance)],
+            &SOLE,
+            0.01,
+            0.0,
+        ) else {
             panic!("the right foot carries");
         };
         assert_eq!(load.share, 1.0);

@@ -63,6 +63,11 @@ pub struct DynamicGaitConfig {
     /// while the body walks on at speed drags the torso round and the stance foot slips about its
     /// vertical axis; absent: the `[controller]` value.
     pub hand_weight: Option<f64>,
+    /// In single support the ZMP reference sits this far from the stance sole's centre towards
+    /// the other foot, along the sole's lateral axis (m; 0: on the centre). A robot whose ankle
+    /// roll range is small cannot tilt its legs far enough to sway the CoM out to the sole
+    /// centres; a ZMP nearer the midline shrinks the lateral sway by the same fraction.
+    pub zmp_inward_offset_m: f64,
     /// The stabilizer closing the loop on force-torque and IMU.
     #[serde(skip)]
     pub stabilizer: StabilizerConfig,
@@ -83,6 +88,7 @@ impl Default for DynamicGaitConfig {
             late_descent_speed: 0.05,
             late_lift_off_max_s: 0.2,
             hand_weight: None,
+            zmp_inward_offset_m: 0.0,
             stabilizer: StabilizerConfig::default(),
         }
     }
@@ -298,6 +304,7 @@ impl DynamicGaitConfig {
             (DYNAMIC, "early_touchdown_s", self.early_touchdown_s),
             (DYNAMIC, "late_touchdown_max_s", self.late_touchdown_max_s),
             (DYNAMIC, "late_lift_off_max_s", self.late_lift_off_max_s),
+            (DYNAMIC, "zmp_inward_offset_m", self.zmp_inward_offset_m),
             (STABILIZER, "zmp_margin_m", s.zmp_margin_m),
             (STABILIZER, "zmp_offset_max_m", s.zmp_offset_max_m),
             (STABILIZER, "foot_damping_gain", s.foot_damping_gain),
@@ -408,6 +415,10 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("double_support_s"), "{error}");
+        let error = parse("[gait.dynamic]\nzmp_inward_offset_m = -0.01\n")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("zmp_inward_offset_m"), "{error}");
         let error = parse("[gait.dynamic.stabilizer]\ndcm_gain = -1.0\n")
             .unwrap_err()
             .to_string();

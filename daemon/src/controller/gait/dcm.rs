@@ -5,8 +5,8 @@
 //! p: ZMP, ground plane). With the DCM `ξ = c + ċ / ω` it splits into a stable and an unstable
 //! part: `ċ = ω (ξ − c)` and `ξ̇ = ω (ξ − p)` (Englsberger et al. 2015).
 //!
-//! The ZMP reference stays at the stance foot's sole centre in single support and crosses to the
-//! next stance foot over the double supports between two steps, from the start point to the
+//! The ZMP reference stays at the stance foot's sole centre in single support (or moved inwards,
+//! towards the other foot, by `zmp_inward_offset_m`) and crosses to the next stance foot over the double supports between two steps, from the start point to the
 //! first stance foot over the initial double support, and from the last one to the centre of the
 //! final feet over the final double support. A crossing follows the minimum-jerk profile
 //! (`TRANSFER_PIECES` linear pieces through it): a ZMP that left a foot in a straight line would
@@ -25,9 +25,10 @@
 //! bump `q·b(τ)`, `b = 16 τ² (1 − τ)²`, whose amplitude `q` makes `ξ(0) = c₀` (`ξ(0)` is affine
 //! in `q`): the ZMP first moves away from the first stance foot, which starts the CoM towards it.
 
-use nalgebra::{Isometry3, Vector2};
+use kinematics::robot::EndEffector;
+use nalgebra::{Isometry3, Point3, Vector2};
 
-use super::footsteps::{Support, SupportPhase};
+use super::footsteps::{FEET, Support, SupportPhase};
 use crate::controller::trajectory::Profile;
 
 /// One linear piece of the ZMP reference and the DCM at its end.
@@ -88,9 +89,10 @@ pub(crate) struct DcmPattern {
 
 impl DcmPattern {
     /// The pattern of `phases` (back to back from time 0) for a pendulum of natural frequency
-    /// `omega` (1/s). It starts from the centre of the first phase's feet until
+    /// `omega` (1/s), the single supports' ZMP `inward` (m) from the stance sole's centre
+    /// towards the other foot. It starts from the centre of the first phase's feet until
     /// [`start_at_rest`](Self::start_at_rest) sets the start point.
-    pub fn new(phases: &[SupportPhase], omega: f64) -> Self {
+    pub fn new(phases: &[SupportPhase], omega: f64, inward: f64) -> Self {
         let first = phases.first().expect("a plan has phases");
         let last = phases.last().expect("a plan has phases");
         let rest = feet_centre(&last.feet);
@@ -100,13 +102,13 @@ impl DcmPattern {
         let mut crossing = (feet_centre(&first.feet), 0.0);
         for phase in phases {
             if let Support::Single(_) = phase.support {
-                let stance = phase
+                let (foot, stance) = phase
                     .feet
                     .iter()
-                    .flatten()
-                    .next()
+                    .enumerate()
+                    .find_map(|(f, pose)| pose.map(|pose| (f, pose)))
                     .expect("single support stands on a foot");
-                let on_stance = stance.translation.vector.xy();
+                let on_stance = stance_zmp(&stance, FEET[foot], inward);
                 push_crossing(&mut segments, crossing, (on_stance, phase.start_s));
                 push_piece(
                     &mut segments,
@@ -143,7 +145,7 @@ impl DcmPattern {
     /// Moves the whole pattern by the planar transform `to_world` (x, y, yaw).
     pub fn transform(&mut self, to_world: &Isometry3<f64>) {
         let map = |p: &mut Vector2<f64>| {
-            let world = to_world * nalgebra::Point3::new(p.x, p.y, 0.0);
+            let world = to_world * Point3::new(p.x, p.y, 0.0);
             *p = world.coords.xy();
         };
         for segment in &mut self.segments {
@@ -271,6 +273,18 @@ fn minimum_jerk(tau: f64) -> f64 {
     Profile::MinimumJerk.sample(tau, 1.0).0
 }
 
+/// The single support's ZMP on the stance sole `pose` of `foot`: `inward` (m) from its centre
+/// along the sole's lateral axis, towards the other foot (the left foot's right, the right
+/// foot's left).
+pub(crate) fn stance_zmp(pose: &Isometry3<f64>, foot: EndEffector, inward: f64) -> Vector2<f64> {
+    let side = if foot == EndEffector::LeftFoot {
+        -1.0
+    } else {
+        1.0
+    };
+    (pose * Point3::new(0.0, side * inward, 0.0)).coords.xy()
+}
+
 /// Mean ground position of the feet on the ground.
 fn feet_centre(feet: &[Option<Isometry3<f64>>; 2]) -> Vector2<f64> {
     let (sum, count) = feet
@@ -334,7 +348,7 @@ mod tests {
 
     fn pattern() -> (FootstepPlan, DcmPattern) {
         let plan = plan();
-        let mut pattern = DcmPattern::new(&plan.phases, OMEGA);
+        let mut pattern = DcmPattern::new(&plan.phases, OMEGA, 0.0);
         pattern.start_at_rest(Vector2::new(0.01, 0.0));
         (plan, pattern)
     }
@@ -436,6 +450,39 @@ mod tests {
                 assert!((middle.zmp - foot.translation.vector.xy()).norm() < 1e-12);
             }
         }
+    }
+
+    #[test]
+    fn an_inward_offset_moves_the_single_support_zmp_towards_the_other_foot() {
+        let plan = plan();
+        let inward = 0.03;
+        let mut pattern = DcmPattern::new(&plan.phases, OMEGA, inward);
+        pattern.start_at_rest(Vector2::new(0.01, 0.0));
+        let mut cursor = 0;
+        let mut singles = 0;
+        for phase in &plan.phases {
+            let Support::Single(swing) = phase.support else {
+                continue;
+            };
+            singles += 1;
+            let foot = phase.feet.iter().flatten().next().unwrap();
+            let centre = foot.translation.vector.xy();
+            let middle = pattern.sample(phase.start_s + phase.duration_s / 2.0, &mut cursor);
+            // The feet stand at y = ±0.095: inward is towards y = 0, by `inward`.
+            let towards_midline = -centre.y.signum() * inward;
+            let expected = centre + Vector2::new(0.0, towards_midline);
+            assert!(
+                (middle.zmp - expected).norm() < 1e-12,
+                "{:?} swinging: ZMP {:?}, expected {expected:?}",
+                swing.foot,
+                middle.zmp
+            );
+            assert!(middle.zmp.y.abs() < centre.y.abs());
+        }
+        assert!(singles > 0);
+        // The pattern still ends at rest on the final feet's centre.
+        let end = pattern.sample(plan.duration_s(), &mut 0);
+        assert!((end.dcm - pattern.rest()).norm() < 1e-12);
     }
 
     #[test]

@@ -75,7 +75,16 @@ impl DynamicPlan {
         );
         let standing = standing.map(|pose| to_standing.inverse() * pose);
         let footsteps = FootstepPlan::new(stances, standing, config)?;
-        let pattern = DcmPattern::new(&footsteps.phases, (GRAVITY / com_height).sqrt());
+        let inward = config.zmp_inward_offset_m;
+        if inward > robot.sole.width / 2.0 {
+            return Err(Refusal(format!(
+                "[gait.dynamic] zmp_inward_offset_m {inward} m puts the single-support ZMP \
+                 outside the {} m wide sole",
+                robot.sole.width
+            )));
+        }
+        let omega = (GRAVITY / com_height).sqrt();
+        let pattern = DcmPattern::new(&footsteps.phases, omega, inward);
         Ok(Self {
             config: *config,
             com_height,

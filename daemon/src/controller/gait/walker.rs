@@ -520,7 +520,8 @@ impl DynamicWalker {
             let e = f as usize;
             self.targets.contacts[e].then_some(&self.targets.anchors[e])
         });
-        let loads = distribute(zmp, feet, &self.sole, config.zmp_margin_m);
+        let inward = self.plan().config.zmp_inward_offset_m;
+        let loads = distribute(zmp, feet, &self.sole, config.zmp_margin_m, inward);
         let forces = FEET.map(|f| sensors.wrenches[f as usize][2]);
         let total: f64 = (0..2)
             .filter(|&f| feet[f].is_some())
