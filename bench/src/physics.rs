@@ -75,17 +75,10 @@ impl Default for PhysicsWalkOptions {
 }
 
 impl PhysicsWalkOptions {
-    /// The defaults for a dynamic walk. Its FT readings are the mean over each control period's
-    /// physics steps (`MujocoOptions::average_ft_over_step`): the stabilizer's measured ZMP is
-    /// built from them, and the last step's reading alone is biased by the servos' answer to
-    /// each new command.
+    /// The defaults for a dynamic walk.
     pub fn dynamic() -> Self {
         Self {
             gait: Gait::Dynamic,
-            mujoco: MujocoOptions {
-                average_ft_over_step: true,
-                ..MujocoOptions::default()
-            },
             ..Self::default()
         }
     }

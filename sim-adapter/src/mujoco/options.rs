@@ -34,8 +34,8 @@ pub struct MujocoOptions {
     pub fall_height_fraction: f64,
     /// ... or when the base link's z axis tilts more than this from vertical (rad).
     pub fall_tilt: f64,
-    /// The FT readings of a `step` are the mean over its physics steps rather than the last
-    /// one's. The stiff servos answer each new command with a force transient in the first
+    /// The FT readings of a `step` are the mean over its physics steps (default) rather than the
+    /// last one's. The stiff servos answer each new command with a force transient in the first
     /// physics step after it, so at two steps per control period the last step's reading is
     /// biased (JVRC-1 swaying in double support: 196 / 399 N on the feet in the second step,
     /// 276 / 353 N in the first, their mean the weight); a real sensor's anti-aliasing filter
@@ -66,7 +66,7 @@ impl Default for MujocoOptions {
             contact_time_constant: 0.005,
             fall_height_fraction: 0.7,
             fall_tilt: 0.6,
-            average_ft_over_step: false,
+            average_ft_over_step: true,
             mass_scale: 1.0,
             pelvis_com_offset: [0.0; 3],
             visual_geoms: true,
