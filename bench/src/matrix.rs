@@ -55,7 +55,7 @@ pub struct MatrixArgs {
     #[arg(long, default_value_t = 1.0)]
     pub mass_scale: f64,
     /// Model error in the simulator only: the pelvis CoM moved by x,y,z (m, pelvis frame).
-    #[arg(long, value_delimiter = ',', num_args = 3, value_name = "X,Y,Z")]
+    #[arg(long, value_delimiter = ',', value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub pelvis_com_offset: Option<Vec<f64>>,
     /// A sideways push on the pelvis (N·s along world y, + = left), centred on the middle of
     /// single support number `--push-step` (dynamic gait).
@@ -259,7 +259,16 @@ fn walk_options(args: &MatrixArgs, gait: Gait) -> anyhow::Result<PhysicsWalkOpti
     options.trace_every = 0;
     options.mujoco.mass_scale = args.mass_scale;
     if let Some(offset) = &args.pelvis_com_offset {
-        options.mujoco.pelvis_com_offset = [offset[0], offset[1], offset[2]];
+        let &[x, y, z] = offset.as_slice() else {
+            anyhow::bail!(
+                "--pelvis-com-offset {offset:?}: expected three numbers x,y,z (m), e.g. 0.01,0,0"
+            );
+        };
+        anyhow::ensure!(
+            offset.iter().all(|v| v.is_finite()),
+            "--pelvis-com-offset {offset:?}: must be finite"
+        );
+        options.mujoco.pelvis_com_offset = [x, y, z];
     }
     if let Some(impulse) = args.push_impulse {
         anyhow::ensure!(
