@@ -247,6 +247,39 @@ pub struct SimMeasurement {
     pub safety: SafetyMetrics,
 }
 
+/// The base pose blended from the anchored feet's `candidates` by their `shares` (equal halves
+/// when both shares are zero); `None` when no foot is anchored.
+fn blend(candidates: &[Option<Isometry3<f64>>; 2], shares: &[f64; 2]) -> Option<Isometry3<f64>> {
+    let mut blended: Option<(Isometry3<f64>, f64)> = None;
+    for (candidate, share) in candidates.iter().zip(shares) {
+        let Some(candidate) = candidate else {
+            continue;
+        };
+        blended = Some(match blended {
+            None => (*candidate, *share),
+            Some((previous, weight)) => {
+                let total = weight + share;
+                let t = if total > 0.0 { share / total } else { 0.5 };
+                let translation = previous
+                    .translation
+                    .vector
+                    .lerp(&candidate.translation.vector, t);
+                let rotation = previous.rotation.nlerp(&candidate.rotation, t);
+                (
+                    Isometry3::from_parts(Translation3::from(translation), rotation),
+                    total,
+                )
+            }
+        });
+    }
+    blended.map(|(mut pose, _)| {
+        // Composing with inverses assumes unit quaternions; without renormalising, a norm
+        // error doubles every step.
+        pose.rotation.renormalize();
+        pose
+    })
+}
+
 /// The simulator: holds the robot state, the contact anchors and the metrics.
 pub struct KinematicSim {
     robot: Arc<Robot>,
@@ -259,9 +292,14 @@ pub struct KinematicSim {
     corners: [[f64; 2]; 8],
     /// Simulated time since the start (s).
     time: f64,
-    /// The CoM of the last two states and the step between them, for the ZMP's acceleration.
-    com_history: [Option<Vector3<f64>>; 2],
-    last_dt: f64,
+    /// The CoM of the last state and its velocity from the motion over the step before it, for
+    /// the ZMP's acceleration.
+    com_history: Option<(Vector3<f64>, Option<Vector3<f64>>)>,
+    /// The anchors and load shares (after the lift fade) the base was last placed with.
+    placement: ([Option<Isometry3<f64>>; 2], [f64; 2]),
+    /// With `judge_by_zmp`: how far the last base placement moved the CoM by changing the feet's
+    /// shares rather than by the joints' motion (see `place_base`).
+    replacement: Vector3<f64>,
     /// The filtered CoM acceleration.
     com_acceleration: Vector3<f64>,
     /// Where the ground reaction acted in the last step (see `resultant`).
@@ -303,8 +341,9 @@ impl KinematicSim {
             summary: SafetySummary::default(),
             corners: [[0.0; 2]; 8],
             time: 0.0,
-            com_history: [None; 2],
-            last_dt: 0.0,
+            com_history: None,
+            placement: ([None; 2], [0.0; 2]),
+            replacement: Vector3::zeros(),
             com_acceleration: Vector3::zeros(),
             support_point: Vector3::zeros(),
         };
@@ -387,40 +426,31 @@ impl KinematicSim {
                 shares[slot] *= (1.0 - lift / self.options.release_tolerance).clamp(0.0, 1.0);
             }
         }
-        let mut blended: Option<(Isometry3<f64>, f64)> = None;
-        for (slot, foot) in FEET.iter().enumerate() {
-            let Some(anchor) = self.anchors[slot] else {
-                continue;
-            };
-            let foot_in_base = base.inverse() * self.pose(*foot);
-            let candidate = anchor * foot_in_base.inverse();
-            blended = Some(match blended {
-                None => (candidate, shares[slot]),
-                Some((previous, weight)) => {
-                    let total = weight + shares[slot];
-                    let t = if total > 0.0 {
-                        shares[slot] / total
-                    } else {
-                        0.5
-                    };
-                    let translation = previous
-                        .translation
-                        .vector
-                        .lerp(&candidate.translation.vector, t);
-                    let rotation = previous.rotation.nlerp(&candidate.rotation, t);
-                    (
-                        Isometry3::from_parts(Translation3::from(translation), rotation),
-                        total,
-                    )
+        let candidates = |anchors: &[Option<Isometry3<f64>>; 2]| {
+            let mut candidates = [None; 2];
+            for (slot, foot) in FEET.iter().enumerate() {
+                if let Some(anchor) = anchors[slot] {
+                    let foot_in_base = base.inverse() * self.pose(*foot);
+                    candidates[slot] = Some(anchor * foot_in_base.inverse());
                 }
-            });
-        }
-        if let Some((mut pose, _)) = blended {
-            // Composing with inverses assumes unit quaternions; without renormalising, a norm
-            // error doubles every step.
-            pose.rotation.renormalize();
+            }
+            candidates
+        };
+        if let Some(pose) = blend(&candidates(&self.anchors), &shares) {
+            if self.options.judge_by_zmp {
+                // Where the base would be had the feet kept last step's anchors and shares: the
+                // difference is the base re-placed between inconsistent anchors (a foot touching
+                // down or released, a load shift), not motion, and must not reach the ZMP's
+                // acceleration (at a touchdown it fed back through the ZMP's lever rule into the
+                // shares until the ZMP left the support).
+                let (anchors, held_shares) = self.placement;
+                let held = blend(&candidates(&anchors), &held_shares).unwrap_or(pose);
+                let com_in_base = base.inverse() * nalgebra::Point3::from(self.kinematics.com());
+                self.replacement = pose * com_in_base - held * com_in_base;
+            }
             self.configuration.base = pose;
         }
+        self.placement = (self.anchors, shares);
         self.kinematics
             .update(&self.robot.model, &self.configuration);
     }
@@ -449,16 +479,19 @@ impl KinematicSim {
     /// motion with `judge_by_zmp`) and the total normal force, in the state after a step of `dt`.
     fn resultant(&mut self, com: &Vector3<f64>, dt: f64) -> (Vector3<f64>, f64) {
         let mass = self.robot.model.total_mass();
-        let history = self.com_history;
-        self.com_history = [Some(*com), history[0]];
-        let previous_dt = std::mem::replace(&mut self.last_dt, dt);
-        let (true, [Some(last), Some(before)]) = (self.options.judge_by_zmp, history) else {
-            return (*com, mass * GRAVITY);
-        };
-        if dt <= 0.0 || previous_dt <= 0.0 {
+        if !self.options.judge_by_zmp {
             return (*com, mass * GRAVITY);
         }
-        let raw = ((com - last) / dt - (last - before) / previous_dt) / dt;
+        let history = self.com_history;
+        let velocity = match history {
+            Some((last, _)) if dt > 0.0 => Some((com - self.replacement - last) / dt),
+            _ => None,
+        };
+        self.com_history = Some((*com, velocity));
+        let (Some(velocity), Some((_, Some(previous_velocity)))) = (velocity, history) else {
+            return (*com, mass * GRAVITY);
+        };
+        let raw = (velocity - previous_velocity) / dt;
         let blend = dt / (self.options.zmp_filter_s + dt);
         self.com_acceleration += (raw - self.com_acceleration) * blend;
         let acceleration = self.com_acceleration;

@@ -247,3 +247,70 @@ fn a_dynamic_walk_is_judged_by_the_zmp_of_its_com_motion() {
         );
     }
 }
+
+#[test]
+fn re_placing_the_base_between_inconsistent_feet_is_not_motion_for_the_zmp() {
+    // Regression: the ZMP's CoM acceleration differentiated the base re-placed when the feet's
+    // shares changed between anchors the command does not agree with (a swing foot still moving
+    // as it touches down). The shares follow the ZMP's lever rule, so the CoM jump moved the ZMP,
+    // which moved the shares further: at JVRC-1's first dynamic touchdown the ZMP left the
+    // support. Here the right foot is slid 0.3 mm sideways while both feet are anchored, then
+    // the robot holds still: nothing moves but the base between the two placements.
+    let robot = robot("jvrc1");
+    let options = SimOptions {
+        judge_by_zmp: true,
+        ..SimOptions::default()
+    };
+    let mut sim = KinematicSim::with_options(robot.clone(), robot.standing.clone(), options)
+        .expect("standing");
+    let (hip, ankle) = (
+        leg_joint(&robot, false, "hip_r"),
+        leg_joint(&robot, false, "ankle_r"),
+    );
+    let mut q = robot.standing.joints.clone();
+    let dt = 0.001;
+    let mut worst_offset: f64 = 0.0;
+    for k in 0..1500 {
+        if k < 100 {
+            q[hip] += 4e-6;
+            q[ankle] -= 4e-6;
+        }
+        sim.step(q.as_slice(), q.as_slice(), dt).unwrap();
+        let m = sim.measurement();
+        assert_eq!(m.contacts, [true, true, false, false], "step {k}");
+        assert!(
+            m.safety.stability_margin > 0.0,
+            "step {k}: ZMP margin {}",
+            m.safety.stability_margin
+        );
+        // The ZMP is where the resultant of the synthetic wrenches acts.
+        let (mut moment, mut normal) = (0.0, 0.0);
+        let mut kinematics = Kinematics::new(&robot.model);
+        kinematics.update(&robot.model, sim.configuration());
+        for (slot, foot) in [EndEffector::LeftFoot, EndEffector::RightFoot]
+            .iter()
+            .enumerate()
+        {
+            let w = m.wrenches[*foot as usize];
+            let o = kinematics
+                .frame_pose(&robot.model, robot.ft_sensors[slot])
+                .translation
+                .vector;
+            moment += o.y * w[2] + w[3] - o.z * w[1];
+            normal += w[2];
+        }
+        // Once the slide's own deceleration has left the ZMP filter.
+        if k >= 400 {
+            worst_offset = worst_offset.max((moment / normal - m.com.y).abs());
+        }
+    }
+    assert!(
+        sim.summary().max_contact_slip > 1e-4,
+        "the feet disagree: slip {}",
+        sim.summary().max_contact_slip
+    );
+    assert!(
+        worst_offset < 1e-6,
+        "holding still, the ZMP stays under the CoM: {worst_offset} m off"
+    );
+}
