@@ -16,7 +16,8 @@
 //! joint resting at its bound oscillate.
 //!
 //! Tasks: CoM x/y (and z at a constant height in the dynamic gait, whose ZMP-feasible CoM
-//! set-point replaces the polygon constraint), end-effector poses, upright base, posture. Jacobian blocks are accumulated
+//! set-point replaces the polygon constraint), end-effector poses, upright base, posture (the
+//! dynamic gait may weigh the torso joints' posture apart). Jacobian blocks are accumulated
 //! over their structurally non-zero columns only, so a foot task costs a few hundred flops.
 //! Everything is preallocated at construction.
 
@@ -48,6 +49,8 @@ pub(crate) struct QpAssembler {
     upright_reference: UnitQuaternion<f64>,
     polygon: SupportPolygon,
     corners: [[f64; 2]; MAX_SUPPORT_POINTS],
+    /// Whether each joint belongs to `[robot.joint_groups] torso`.
+    torso_joints: Vec<bool>,
 }
 
 impl QpAssembler {
@@ -95,6 +98,9 @@ impl QpAssembler {
             upright_reference: robot.standing.base.rotation,
             polygon: SupportPolygon::empty(),
             corners: [[0.0; 2]; MAX_SUPPORT_POINTS],
+            torso_joints: (0..model.dof())
+                .map(|j| robot.joint_groups.torso.contains(&j))
+                .collect(),
         }
     }
 
@@ -201,11 +207,15 @@ impl QpAssembler {
             q[3 + k] -= config.torso_weight * config.torso_gain * tilt[k];
         }
 
-        // Posture.
+        // Posture (the torso joints at their own weight when the gait asks for it).
         for j in 0..model.dof() {
+            let weight = match targets.torso_posture_weight {
+                Some(weight) if self.torso_joints[j] => weight,
+                _ => config.posture_weight,
+            };
             let error = posture[j] - configuration.joints[j];
-            p[(6 + j, 6 + j)] += config.posture_weight;
-            q[6 + j] -= config.posture_weight * config.posture_gain * error;
+            p[(6 + j, 6 + j)] += weight;
+            q[6 + j] -= weight * config.posture_gain * error;
         }
 
         // Feet in contact do not move: J_c ν = K (anchor − pose), which is 0 while the estimate

@@ -57,6 +57,9 @@ pub(crate) struct Targets {
     /// Velocities of the feet in contact on top of holding their anchors (linear xyz, angular
     /// xyz, world; left, right): the dynamic gait's force and CoP compliance.
     pub contact_velocity: [[f64; 6]; 2],
+    /// Replaces `posture_weight` on the torso joints (`[robot.joint_groups] torso`): the dynamic
+    /// gait's `torso_posture_weight`; `None`: the configured posture weight.
+    pub torso_posture_weight: Option<f64>,
 }
 
 impl Targets {
@@ -156,6 +159,7 @@ impl StateMachine {
                 unloading: None,
                 balance: Balance::SupportPolygon,
                 contact_velocity: [[0.0; 6]; 2],
+                torso_posture_weight: None,
             },
         }
     }

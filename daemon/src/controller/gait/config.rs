@@ -68,6 +68,12 @@ pub struct DynamicGaitConfig {
     /// roll range is small cannot tilt its legs far enough to sway the CoM out to the sole
     /// centres; a ZMP nearer the midline shrinks the lateral sway by the same fraction.
     pub zmp_inward_offset_m: f64,
+    /// Replaces `[controller] posture_weight` on the torso joints (`[robot.joint_groups] torso`)
+    /// in the dynamic gait. At the posture weight the QP keeps a held hand in place largely with
+    /// the waist, whose long lever makes it cheap: the upper body swung round and sideways while
+    /// the body walked on, the stance sole rolled onto a corner and turned about it, and walks
+    /// with a held hand fell. Absent: the `[controller]` value.
+    pub torso_posture_weight: Option<f64>,
     /// The stabilizer closing the loop on force-torque and IMU.
     #[serde(skip)]
     pub stabilizer: StabilizerConfig,
@@ -89,6 +95,7 @@ impl Default for DynamicGaitConfig {
             late_lift_off_max_s: 0.2,
             hand_weight: None,
             zmp_inward_offset_m: 0.0,
+            torso_posture_weight: None,
             stabilizer: StabilizerConfig::default(),
         }
     }
@@ -288,6 +295,11 @@ impl DynamicGaitConfig {
             (DYNAMIC, "hand_transition_s", self.hand_transition_s),
             (DYNAMIC, "com_height_m", self.com_height_m.unwrap_or(1.0)),
             (DYNAMIC, "hand_weight", self.hand_weight.unwrap_or(1.0)),
+            (
+                DYNAMIC,
+                "torso_posture_weight",
+                self.torso_posture_weight.unwrap_or(1.0),
+            ),
             (DYNAMIC, "late_descent_speed", self.late_descent_speed),
             (STABILIZER, "dcm_gain", s.dcm_gain),
             (STABILIZER, "velocity_filter_s", s.velocity_filter_s),

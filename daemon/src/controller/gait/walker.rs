@@ -498,6 +498,7 @@ impl DynamicWalker {
         self.targets.com = command.com;
         self.targets.com_velocity = command.com_velocity;
         self.targets.balance = Balance::ComHeight(ground + self.plan().com_height);
+        self.targets.torso_posture_weight = self.plan().config.torso_posture_weight;
         self.comply(command.zmp, sensors, ground, dt);
         let offset = self.stabilizer.zmp_offset();
         let xy = |v: Vector2<f64>| [v.x, v.y];
