@@ -55,7 +55,12 @@ pub struct MatrixArgs {
     #[arg(long, default_value_t = 1.0)]
     pub mass_scale: f64,
     /// Model error in the simulator only: the pelvis CoM moved by x,y,z (m, pelvis frame).
-    #[arg(long, value_delimiter = ',', value_name = "X,Y,Z", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "X,Y,Z",
+        allow_hyphen_values = true
+    )]
     pub pelvis_com_offset: Option<Vec<f64>>,
     /// A sideways push on the pelvis (N·s along world y, + = left), centred on the middle of
     /// single support number `--push-step` (dynamic gait).
@@ -312,6 +317,7 @@ fn run_all(
                         break;
                     };
                     let result = walk_distance(config, args.urdf.as_deref(), request, options)
+                        .and_then(|report| pushed_if_asked(options, report))
                         .with_context(|| {
                             format!(
                                 "{} {} m seed {}",
@@ -333,6 +339,22 @@ fn run_all(
         .into_iter()
         .map(|run| run.expect("every request ran"))
         .collect()
+}
+
+/// A walk asked to be pushed that reached `done` without its push (it had fewer single
+/// supports than `--push-step`) is an error, not a survived push.
+fn pushed_if_asked(
+    options: &PhysicsWalkOptions,
+    report: PhysicsWalkReport,
+) -> anyhow::Result<PhysicsWalkReport> {
+    match options.push {
+        Some(push) if report.success() && report.pushed_at_s.is_none() => anyhow::bail!(
+            "the walk ended before single support number {} (--push-step, 0: the first): it was \
+             never pushed; choose an earlier step",
+            push.step
+        ),
+        _ => Ok(report),
+    }
 }
 
 fn groups(args: &MatrixArgs, runs: &[MatrixRun]) -> Vec<MatrixGroup> {

@@ -183,6 +183,10 @@ pub struct PhysicsWalkReport {
     /// The controller's balance readings next to the simulator's CoM, every
     /// [`PhysicsWalkOptions::trace_every`] ticks.
     pub balance_trace: Vec<BalanceSample>,
+    /// Simulated time the [`PhysicsWalkOptions::push`] began (s): `None` without a push, or
+    /// when the walk ended before its single support, so that a push sweep cannot count a walk
+    /// that was never pushed as surviving.
+    pub pushed_at_s: Option<f64>,
 }
 
 /// One sample of [`PhysicsWalkReport::balance_trace`].
@@ -407,6 +411,7 @@ pub fn walk_sequence(
         tick_us,
         balance: loop_state.balance.tracking(),
         balance_trace: loop_state.balance_trace,
+        pushed_at_s: loop_state.push.and_then(|push| push.applied_at),
     })
 }
 
