@@ -31,6 +31,30 @@ fn leg_joint(robot: &Robot, prefix_left: bool, contains: &str) -> usize {
         .expect("leg joint exists")
 }
 
+/// The feet's ground wrenches summed at the world origin: the moments about x and y that put
+/// their resultant at the centre of pressure (`p_y = m_x / F_z`, `p_x = m_y / F_z`), and the
+/// normal force `F_z`.
+fn feet_resultant(robot: &Robot, sim: &KinematicSim) -> (f64, f64, f64) {
+    let m = sim.measurement();
+    let mut kinematics = Kinematics::new(&robot.model);
+    kinematics.update(&robot.model, sim.configuration());
+    let (mut moment_x, mut moment_y, mut normal) = (0.0, 0.0, 0.0);
+    for (slot, foot) in [EndEffector::LeftFoot, EndEffector::RightFoot]
+        .iter()
+        .enumerate()
+    {
+        let w = m.wrenches[*foot as usize];
+        let o = kinematics
+            .frame_pose(&robot.model, robot.ft_sensors[slot])
+            .translation
+            .vector;
+        moment_x += o.y * w[2] - o.z * w[1] + w[3];
+        moment_y += o.x * w[2] - o.z * w[0] - w[4];
+        normal += w[2];
+    }
+    (moment_x, moment_y, normal)
+}
+
 #[test]
 fn standing_robot_is_supported_by_both_feet_with_its_weight() {
     for name in ["jvrc1", "armar4"] {
@@ -47,21 +71,8 @@ fn standing_robot_is_supported_by_both_feet_with_its_weight() {
         assert!(m.safety.stability_margin > 0.0, "{name}");
         assert_eq!(m.safety.contact_slip, 0.0);
         // Moment balance: the resultant of the ground forces acts below the CoM.
-        let mut kinematics = Kinematics::new(&robot.model);
-        kinematics.update(&robot.model, sim.configuration());
-        let mut moment_x = 0.0;
-        for (slot, foot) in [EndEffector::LeftFoot, EndEffector::RightFoot]
-            .iter()
-            .enumerate()
-        {
-            let w = m.wrenches[*foot as usize];
-            let sensor = kinematics
-                .frame_pose(&robot.model, robot.ft_sensors[slot])
-                .translation
-                .vector;
-            // Moment about the world origin: r × F + τ; its x part must equal (c × W)_x.
-            moment_x += sensor.y * w[2] - sensor.z * w[1] + w[3];
-        }
+        // Moment about the world origin: r × F + τ; its x part must equal (c × W)_x.
+        let (moment_x, _, _) = feet_resultant(&robot, &sim);
         assert!(
             (moment_x - m.com.y * weight).abs() < 1e-6 * weight,
             "{name}: {moment_x}"
@@ -203,7 +214,6 @@ fn a_dynamic_walk_is_judged_by_the_zmp_of_its_com_motion() {
         leg_joint(&robot, false, "ankle_p"),
     ];
     let dt = 0.002;
-    let mut kinematics = Kinematics::new(&robot.model);
     let mut coms = Vec::new();
     for k in 0..300 {
         let mut q = robot.standing.joints.clone();
@@ -221,20 +231,7 @@ fn a_dynamic_walk_is_judged_by_the_zmp_of_its_com_motion() {
         let acceleration = (coms[n - 1] - 2.0 * coms[n - 2] + coms[n - 3]) / (dt * dt);
         let zmp = coms[n - 1].x - acceleration.x * coms[n - 1].z / GRAVITY;
         // The resultant of the synthetic wrenches acts at that ZMP with m (g + z̈).
-        kinematics.update(&robot.model, sim.configuration());
-        let (mut moment, mut normal) = (0.0, 0.0);
-        for (slot, foot) in [EndEffector::LeftFoot, EndEffector::RightFoot]
-            .iter()
-            .enumerate()
-        {
-            let w = m.wrenches[*foot as usize];
-            let o = kinematics
-                .frame_pose(&robot.model, robot.ft_sensors[slot])
-                .translation
-                .vector;
-            moment += o.x * w[2] - w[4] - o.z * w[0];
-            normal += w[2];
-        }
+        let (_, moment, normal) = feet_resultant(&robot, &sim);
         let weight = robot.model.total_mass() * (GRAVITY + acceleration.z);
         assert!(
             (normal - weight).abs() < 1e-6 * weight,
@@ -284,21 +281,7 @@ fn re_placing_the_base_between_inconsistent_feet_is_not_motion_for_the_zmp() {
             m.safety.stability_margin
         );
         // The ZMP is where the resultant of the synthetic wrenches acts.
-        let (mut moment, mut normal) = (0.0, 0.0);
-        let mut kinematics = Kinematics::new(&robot.model);
-        kinematics.update(&robot.model, sim.configuration());
-        for (slot, foot) in [EndEffector::LeftFoot, EndEffector::RightFoot]
-            .iter()
-            .enumerate()
-        {
-            let w = m.wrenches[*foot as usize];
-            let o = kinematics
-                .frame_pose(&robot.model, robot.ft_sensors[slot])
-                .translation
-                .vector;
-            moment += o.y * w[2] + w[3] - o.z * w[1];
-            normal += w[2];
-        }
+        let (moment, _, normal) = feet_resultant(&robot, &sim);
         // Once the slide's own deceleration has left the ZMP filter.
         if k >= 400 {
             worst_offset = worst_offset.max((moment / normal - m.com.y).abs());
