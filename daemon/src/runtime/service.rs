@@ -126,7 +126,12 @@ impl ServiceLoop {
 
     /// Publishes the newest status and keeps systemd informed.
     pub fn publish_status(&mut self) -> Result<(), ShmError> {
-        let status = self.requests.status_in.read();
+        let mut status = self.requests.status_in.read();
+        if status.timestamp_ns == 0 {
+            // Before the control loop's first status: stamped now, not at the clock's origin
+            // (an observer files messages by their time stamps).
+            status.timestamp_ns = shm_types::monotonic_ns();
+        }
         self.ports.publish_status(&status)?;
         self.feed_watchdog();
         let link_changed = status.link != self.last_link;
