@@ -426,6 +426,8 @@ impl KinematicSim {
                 shares[slot] *= (1.0 - lift / self.options.release_tolerance).clamp(0.0, 1.0);
             }
         }
+        // Zero unless this placement re-places the base (below).
+        self.replacement = Vector3::zeros();
         let candidates = |anchors: &[Option<Isometry3<f64>>; 2]| {
             let mut candidates = [None; 2];
             for (slot, foot) in FEET.iter().enumerate() {

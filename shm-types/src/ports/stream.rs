@@ -50,14 +50,7 @@ impl<T: StreamPayload> StreamSender<T> {
     /// Fills a message in shared memory in place, sends it and wakes the listeners.
     /// No heap allocation.
     pub(crate) fn send(&self, fill: impl FnOnce(&mut T)) -> Result<(), ShmError> {
-        let mut sample = self
-            .publisher
-            .loan()
-            .map_err(|e| ShmError::ipc("loan a sample on", &self.service_name, e))?;
-        fill(sample.payload_mut());
-        sample
-            .send()
-            .map_err(|e| ShmError::ipc("send on", &self.service_name, e))?;
+        super::send_in_place(&self.publisher, &self.service_name, fill)?;
         self.notifier
             .notify()
             .map_err(|e| ShmError::ipc("notify on", &self.service_name, e))?;

@@ -33,14 +33,6 @@ impl TelemetrySender {
 
     /// Fills a message in shared memory in place and sends it. No heap allocation.
     pub(crate) fn send(&self, fill: impl FnOnce(&mut Telemetry)) -> Result<(), ShmError> {
-        let mut sample = self
-            .publisher
-            .loan()
-            .map_err(|e| ShmError::ipc("loan a sample on", &self.service_name, e))?;
-        fill(sample.payload_mut());
-        sample
-            .send()
-            .map(|_| ())
-            .map_err(|e| ShmError::ipc("send on", &self.service_name, e))
+        super::send_in_place(&self.publisher, &self.service_name, fill)
     }
 }
