@@ -10,9 +10,10 @@ use std::sync::Mutex;
 
 use anyhow::Context;
 
+use client::evaluate::{GroupSummary, MatrixCells, WalkRecord, group_by_cell, speed_cell};
 use kinematics::ConfigFile;
 use serde::Serialize;
-use stance::{AffordanceSet, Gait, WalkRequest};
+use stance::{Gait, WalkRequest};
 
 use crate::physics::{PhysicsWalkOptions, PhysicsWalkReport, Push, walk_distance};
 
@@ -28,22 +29,9 @@ pub struct MatrixArgs {
     /// Gait; default: the config's `[gait] default`.
     #[arg(long)]
     pub gait: Option<Gait>,
-    /// Affordance sets.
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "feet,feet+left-hand,feet+right-hand"
-    )]
-    pub affordances: Vec<AffordanceSet>,
-    /// Distances to walk (m).
-    #[arg(long, value_delimiter = ',', default_value = "1,5")]
-    pub distances: Vec<f64>,
-    /// Runs per affordance set and distance; run i uses generator seed `first_seed + i`.
-    #[arg(long, default_value_t = 10)]
-    pub runs: u64,
-    /// Seed of the first run.
-    #[arg(long, default_value_t = 0)]
-    pub first_seed: u64,
+    /// Affordance sets, distances and runs (run i uses generator seed `first_seed + i`).
+    #[command(flatten)]
+    pub cells: MatrixCells,
     /// Control rate (Hz).
     #[arg(long, default_value_t = 500.0)]
     pub rate_hz: f64,
@@ -83,28 +71,11 @@ pub struct MatrixArgs {
 /// One walk of the matrix.
 #[derive(Clone, Debug, Serialize)]
 pub struct MatrixRun {
-    /// Affordance set.
-    pub affordances: String,
-    /// Requested distance (m).
-    pub distance_m: f64,
-    /// Generator seed.
-    pub seed: u64,
-    /// `done`, `fell`, `fault:<code>`, `time_limit`, `unstable`, or `error` (see `error`).
-    pub outcome: String,
-    /// Why the walk could not run at all.
+    /// What the walk measured (the record `walkctl evaluate` keeps too).
+    #[serde(flatten)]
+    pub record: WalkRecord,
+    /// Why the walk could not run at all (its outcome is then `error`).
     pub error: Option<String>,
-    /// Stances in the sequence.
-    pub stances: usize,
-    /// Distance the feet travelled (m).
-    pub walked_m: f64,
-    /// Walked distance over the time from the first step to the outcome (m/s).
-    pub speed_m_s: Option<f64>,
-    /// Simulated time to the outcome (s).
-    pub sim_s: f64,
-    /// Largest controller-vs-simulator CoM or sole distance (m).
-    pub drift_m: f64,
-    /// Largest base tilt (rad).
-    pub max_tilt_rad: f64,
     /// Measured minus reference ZMP, rms (m; dynamic gait).
     pub zmp_rms_m: f64,
     /// True minus reference DCM, rms (m; dynamic gait).
@@ -115,62 +86,53 @@ pub struct MatrixRun {
 
 impl MatrixRun {
     fn new(request: &WalkRequest, result: anyhow::Result<PhysicsWalkReport>) -> Self {
-        let mut run = Self {
-            affordances: request.affordances.name().to_owned(),
+        let record = |outcome: String| WalkRecord {
+            affordances: request.affordances,
             distance_m: request.distance,
             seed: request.seed,
-            outcome: "error".to_owned(),
-            error: None,
+            outcome,
+            success: false,
             stances: 0,
             walked_m: 0.0,
             speed_m_s: None,
             sim_s: 0.0,
-            drift_m: 0.0,
+            drift_m: None,
             max_tilt_rad: 0.0,
-            zmp_rms_m: 0.0,
-            dcm_rms_m: 0.0,
-            tick_us: [0.0; 3],
         };
         match result {
-            Err(error) => run.error = Some(format!("{error:#}")),
-            Ok(report) => {
-                run.outcome = report.outcome.label();
-                run.stances = report.stances;
-                run.walked_m = report.distance_m;
-                run.speed_m_s = report.speed_m_s();
-                run.sim_s = report.sim_s;
-                run.drift_m = report.drift_m();
-                run.max_tilt_rad = report.max_tilt_rad;
-                run.zmp_rms_m = report.balance.zmp_rms_m;
-                run.dcm_rms_m = report.balance.dcm_rms_m;
-                run.tick_us = report.tick_us;
-            }
+            Err(error) => Self {
+                record: record("error".to_owned()),
+                error: Some(format!("{error:#}")),
+                zmp_rms_m: 0.0,
+                dcm_rms_m: 0.0,
+                tick_us: [0.0; 3],
+            },
+            Ok(report) => Self {
+                record: WalkRecord {
+                    success: report.success(),
+                    stances: report.stances,
+                    walked_m: report.distance_m,
+                    speed_m_s: report.speed_m_s(),
+                    sim_s: report.sim_s,
+                    drift_m: Some(report.drift_m()),
+                    max_tilt_rad: report.max_tilt_rad,
+                    ..record(report.outcome.label())
+                },
+                error: None,
+                zmp_rms_m: report.balance.zmp_rms_m,
+                dcm_rms_m: report.balance.dcm_rms_m,
+                tick_us: report.tick_us,
+            },
         }
-        run
-    }
-
-    fn done(&self) -> bool {
-        self.outcome == "done"
     }
 }
 
 /// The runs of one affordance set and distance, summed up.
 #[derive(Clone, Debug, Serialize)]
 pub struct MatrixGroup {
-    /// Affordance set.
-    pub affordances: String,
-    /// Requested distance (m).
-    pub distance_m: f64,
-    /// Runs `done`.
-    pub done: usize,
-    /// Runs in all.
-    pub runs: usize,
-    /// Speed of the `done` runs: mean, smallest (m/s).
-    pub speed_mean_m_s: Option<f64>,
-    /// Smallest speed of a `done` run (m/s).
-    pub speed_min_m_s: Option<f64>,
-    /// Largest drift of a run (m).
-    pub drift_max_m: f64,
+    /// Successes, speeds and drift (as `walkctl evaluate` sums them up).
+    #[serde(flatten)]
+    pub summary: GroupSummary,
     /// Largest tick p99 of a run (µs).
     pub tick_p99_max_us: f64,
 }
@@ -230,26 +192,14 @@ fn run(args: &MatrixArgs) -> anyhow::Result<MatrixReport> {
         .and_then(toml::Value::as_str)
         .unwrap_or("robot")
         .to_owned();
-    let requests: Vec<WalkRequest> = args
-        .affordances
-        .iter()
-        .flat_map(|&affordances| {
-            args.distances.iter().flat_map(move |&distance| {
-                (0..args.runs).map(move |i| WalkRequest {
-                    distance,
-                    affordances,
-                    seed: args.first_seed + i,
-                })
-            })
-        })
-        .collect();
+    let requests = args.cells.requests()?;
     let runs = run_all(&config, args, &options, &requests);
-    let groups = groups(args, &runs);
+    let groups = groups(&runs);
     Ok(MatrixReport {
         robot: robot_name,
         gait: gait.name().to_owned(),
         overrides: args.overrides.clone(),
-        done: runs.iter().filter(|r| r.done()).count(),
+        done: runs.iter().filter(|r| r.record.success).count(),
         runs,
         groups,
     })
@@ -357,56 +307,38 @@ fn pushed_if_asked(
     }
 }
 
-fn groups(args: &MatrixArgs, runs: &[MatrixRun]) -> Vec<MatrixGroup> {
-    let mut groups = Vec::new();
-    for affordances in &args.affordances {
-        for &distance in &args.distances {
-            let members: Vec<&MatrixRun> = runs
-                .iter()
-                .filter(|r| r.affordances == affordances.name() && r.distance_m == distance)
-                .collect();
-            let speeds: Vec<f64> = members
-                .iter()
-                .filter(|r| r.done())
-                .filter_map(|r| r.speed_m_s)
-                .collect();
-            groups.push(MatrixGroup {
-                affordances: affordances.name().to_owned(),
-                distance_m: distance,
-                done: members.iter().filter(|r| r.done()).count(),
-                runs: members.len(),
-                speed_mean_m_s: (!speeds.is_empty())
-                    .then(|| speeds.iter().sum::<f64>() / speeds.len() as f64),
-                speed_min_m_s: speeds.iter().copied().reduce(f64::min),
-                drift_max_m: members.iter().map(|r| r.drift_m).fold(0.0, f64::max),
-                tick_p99_max_us: members.iter().map(|r| r.tick_us[1]).fold(0.0, f64::max),
-            });
-        }
-    }
-    groups
+fn groups(runs: &[MatrixRun]) -> Vec<MatrixGroup> {
+    group_by_cell(runs, |run| &run.record)
+        .into_iter()
+        .map(|(summary, members)| MatrixGroup {
+            summary,
+            tick_p99_max_us: members.iter().map(|r| r.tick_us[1]).fold(0.0, f64::max),
+        })
+        .collect()
 }
 
 fn run_line(run: &MatrixRun) -> String {
+    let r = &run.record;
     if let Some(error) = &run.error {
         return format!(
             "{} {} m seed {}: error: {error}",
-            run.affordances, run.distance_m, run.seed
+            r.affordances, r.distance_m, r.seed
         );
     }
     format!(
         "{} {} m seed {}: {} after {} stances, {:.3} m in {:.2} s, {}, drift {:.3} m, tilt {:.3} \
          rad, ZMP rms {:.3} m, DCM rms {:.3} m, tick p50 {:.1} p99 {:.1} µs",
-        run.affordances,
-        run.distance_m,
-        run.seed,
-        run.outcome,
-        run.stances,
-        run.walked_m,
-        run.sim_s,
-        run.speed_m_s
+        r.affordances,
+        r.distance_m,
+        r.seed,
+        r.outcome,
+        r.stances,
+        r.walked_m,
+        r.sim_s,
+        r.speed_m_s
             .map_or("no step".to_owned(), |v| format!("{v:.3} m/s")),
-        run.drift_m,
-        run.max_tilt_rad,
+        r.drift_m.unwrap_or(0.0),
+        r.max_tilt_rad,
         run.zmp_rms_m,
         run.dcm_rms_m,
         run.tick_us[0],
@@ -429,18 +361,18 @@ fn print_table(report: &MatrixReport) {
         "{:<16} {:>6} {:>6} {:>11} {:>10} {:>9} {:>10}",
         "affordances", "dist", "done", "speed mean", "speed min", "drift", "tick p99"
     );
-    let speed = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.3}"));
-    for g in &report.groups {
+    for group in &report.groups {
+        let g = &group.summary;
         println!(
             "{:<16} {:>5}m {:>3}/{:<2} {:>11} {:>10} {:>8.3}m {:>8.1}µs",
-            g.affordances,
+            g.affordances.name(),
             g.distance_m,
             g.done,
             g.runs,
-            speed(g.speed_mean_m_s),
-            speed(g.speed_min_m_s),
+            speed_cell(g.speed_mean_m_s),
+            speed_cell(g.speed_min_m_s),
             g.drift_max_m,
-            g.tick_p99_max_us
+            group.tick_p99_max_us
         );
     }
     println!("{} of {} runs done", report.done, report.runs.len());

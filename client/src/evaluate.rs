@@ -1,6 +1,7 @@
 //! `walkctl evaluate`: the paper's execution evaluation over the real processes.
 //!
-//! For every robot × affordance set × distance × run it generates a walk (seed = run number),
+//! For every robot × affordance set × distance × run it generates a walk (run i: seed
+//! `--first-seed` + i),
 //! post-processes it, starts its own `walkd` and `walk-sim --physics <backend>` in lockstep on a
 //! service prefix of its own, submits the walk, records the daemon's status stream and stops the
 //! processes. Meanwhile it records the simulator's ground truth, which `walk-sim` publishes with
@@ -18,9 +19,11 @@
 pub(crate) mod balance;
 pub mod fig6;
 pub mod filmstrip;
+pub mod record;
 pub(crate) mod truth;
 
 pub use fig6::{BalanceSample, write_fig6};
+pub use record::{GroupSummary, MatrixCells, WalkRecord, group_by_cell, speed_cell};
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -46,19 +49,9 @@ pub struct EvaluateArgs {
     /// Robots (config names under the config directory).
     #[arg(long, value_delimiter = ',', default_value = "armar4,jvrc1")]
     pub robots: Vec<String>,
-    /// Affordance sets.
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "feet,feet+left-hand,feet+right-hand"
-    )]
-    pub affordances: Vec<AffordanceSet>,
-    /// Distances to walk (m).
-    #[arg(long, value_delimiter = ',', default_value = "1,5")]
-    pub distances: Vec<f64>,
-    /// Runs per robot, affordance set and distance (run i uses generator seed i).
-    #[arg(long, default_value_t = 10)]
-    pub runs: u32,
+    /// Affordance sets, distances and runs (run i uses generator seed `first_seed + i`).
+    #[command(flatten)]
+    pub cells: MatrixCells,
     /// Simulator of `walk-sim`: mujoco or kinematic.
     #[arg(long, default_value = "mujoco")]
     pub physics: Physics,
@@ -201,47 +194,27 @@ pub struct TraceSample {
     pub sim: Option<Points>,
 }
 
-/// What one run measured.
+/// What one run of `walkctl evaluate` measured: the matrix record and what only a run over
+/// processes knows.
 #[derive(Clone, Debug)]
 pub struct RunResult {
     /// Robot config name.
     pub robot: String,
-    /// Affordance set.
-    pub affordances: AffordanceSet,
-    /// Requested distance (m).
-    pub distance_m: f64,
-    /// Run number (= generator seed).
-    pub run: u32,
-    /// `done` and the simulator's fall rule never fired.
-    pub success: bool,
-    /// `done`, `fault: <reason>`, `fell at <t> s (daemon: <outcome>)`, ...
-    pub outcome: String,
-    /// Simulated (control-tick) time from submission to the end (s).
-    pub sim_s: f64,
+    /// The matrix record; its seed is the run number, its drift `None` when no status could be
+    /// paired with a simulator state.
+    pub record: WalkRecord,
     /// Wall time from submission to the end (s).
     pub wall_s: f64,
     /// Largest distance of a simulated sole from its final target at the end (m).
     pub final_position_error_m: f64,
-    /// Largest controller-vs-simulator distance of the CoM or a sole over the walk (m); `None`
-    /// when no status could be paired with a simulator state.
-    pub drift_m: Option<f64>,
-    /// Statuses paired with a simulator state (the samples `drift_m` is the maximum of).
+    /// Statuses paired with a simulator state (the samples the drift is the maximum of).
     pub drift_samples: usize,
-    /// Largest tilt of the simulated `base_link` from the vertical during the walk (rad).
-    pub max_tilt_rad: f64,
     /// Simulated time from submission at which the simulator's fall rule first fired (s).
     pub fell_at_s: Option<f64>,
-    /// Stances in the walk.
-    pub stances: usize,
     /// The stance the daemon was moving towards at the end.
     pub stance_reached: u32,
     /// The gait walked.
     pub gait: Gait,
-    /// Horizontal distance the simulated soles' midpoint travelled (m).
-    pub walked_m: f64,
-    /// Walking speed: `walked_m` over the simulated time from the first step (a simulated sole
-    /// rising 1 cm) to the end (m/s); `None` if no step was seen.
-    pub speed_m_s: Option<f64>,
     /// The status stream as a Fig. 6 trace.
     pub trace: Vec<TraceSample>,
     /// A dynamic walk's ZMP and DCM from walkd's telemetry (empty for the static gait).
@@ -250,25 +223,26 @@ pub struct RunResult {
 
 impl RunResult {
     fn json(&self) -> serde_json::Value {
+        let r = &self.record;
         serde_json::json!({
             "robot": self.robot,
-            "affordances": self.affordances.name(),
-            "distance_m": self.distance_m,
-            "run": self.run,
-            "success": self.success,
-            "outcome": self.outcome,
-            "sim_s": self.sim_s,
+            "affordances": r.affordances.name(),
+            "distance_m": r.distance_m,
+            "run": r.seed,
+            "success": r.success,
+            "outcome": r.outcome,
+            "sim_s": r.sim_s,
             "wall_s": self.wall_s,
-            "drift_m": self.drift_m,
+            "drift_m": r.drift_m,
             "drift_samples": self.drift_samples,
-            "max_tilt_rad": self.max_tilt_rad,
+            "max_tilt_rad": r.max_tilt_rad,
             "fell_at_s": self.fell_at_s,
             "final_position_error_m": self.final_position_error_m,
-            "stances": self.stances,
+            "stances": r.stances,
             "stance_reached": self.stance_reached,
             "gait": self.gait.name(),
-            "walked_m": self.walked_m,
-            "speed_m_s": self.speed_m_s,
+            "walked_m": r.walked_m,
+            "speed_m_s": r.speed_m_s,
         })
     }
 }
@@ -276,27 +250,25 @@ impl RunResult {
 /// `walkctl evaluate`: runs the matrix, prints the table or JSON, writes the plots; fails unless
 /// every run succeeded.
 pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
-    anyhow::ensure!(args.runs > 0, "--runs must be at least 1");
-    anyhow::ensure!(
-        args.distances.iter().all(|d| d.is_finite() && *d > 0.0),
-        "--distances must be positive numbers"
-    );
+    let requests = args.cells.requests()?;
     let mut results = Vec::new();
     for robot in &args.robots {
         let config = args.config_dir.join(format!("{robot}.toml"));
         let model = Robot::load(&config, args.urdf.as_deref())
             .with_context(|| format!("robot `{robot}` ({})", config.display()))?;
-        for &affordances in &args.affordances {
-            for &distance in &args.distances {
-                for run in 0..args.runs {
-                    let result = run_once(args, robot, &model, &config, affordances, distance, run)
-                        .with_context(|| format!("{robot} {affordances} {distance} m run {run}"))?;
-                    if !args.json {
-                        eprintln!("{}", row(&result));
-                    }
-                    results.push(result);
-                }
+        for (i, request) in requests.iter().enumerate() {
+            let pictured = args.snapshots.as_deref().filter(|_| i == 0);
+            let result =
+                run_once(args, robot, &model, &config, request, pictured).with_context(|| {
+                    format!(
+                        "{robot} {} {} m run {}",
+                        request.affordances, request.distance, request.seed
+                    )
+                })?;
+            if !args.json {
+                eprintln!("{}", row(&result));
             }
+            results.push(result);
         }
         if let Some(dir) = &args.plots {
             plot_robot(dir, robot, &results)?;
@@ -308,7 +280,7 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
     } else {
         print!("{}", summary(&results));
     }
-    let failed = results.iter().filter(|r| !r.success).count();
+    let failed = results.iter().filter(|r| !r.record.success).count();
     if failed > 0 {
         bail!("{failed} of {} runs did not succeed", results.len());
     }
@@ -319,7 +291,7 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
 fn plot_robot(dir: &Path, robot: &str, results: &[RunResult]) -> anyhow::Result<()> {
     let mine = || results.iter().filter(|r| r.robot == robot);
     let Some(result) = mine()
-        .find(|r| r.affordances == AffordanceSet::Feet)
+        .find(|r| r.record.affordances == AffordanceSet::Feet)
         .or_else(|| mine().next())
     else {
         return Ok(());
@@ -328,33 +300,33 @@ fn plot_robot(dir: &Path, robot: &str, results: &[RunResult]) -> anyhow::Result<
     let file = dir.join(format!("fig6_{robot}.svg"));
     let title = format!(
         "{robot}, {} m, {}, run {} ({})",
-        result.distance_m,
-        result.affordances.name(),
-        result.run,
-        result.outcome
+        result.record.distance_m,
+        result.record.affordances.name(),
+        result.record.seed,
+        result.record.outcome
     );
     write_fig6(&file, &title, &result.trace, &result.balance)
 }
 
-/// One run: own processes on an own prefix, submit, record, stop.
+/// One run: own processes on an own prefix, submit, record, stop; with `pictured`, the
+/// snapshots of `--snapshots` go there.
 fn run_once(
     args: &EvaluateArgs,
     robot: &str,
     model: &Robot,
     config: &Path,
-    affordances: AffordanceSet,
-    distance: f64,
-    run: u32,
+    request: &WalkRequest,
+    pictured: Option<&Path>,
 ) -> anyhow::Result<RunResult> {
     let file = ConfigFile::load(config)?;
     let gait = Gait::chosen_or_configured(args.gait, &file)?;
     let params = stance::PostProcessParams::from_config_for(&file, gait)?;
-    let request = WalkRequest {
+    let &WalkRequest {
         distance,
         affordances,
-        seed: u64::from(run),
-    };
-    let sequence = stance::synthetic_walk(model, &params, &request)?;
+        seed: run,
+    } = request;
+    let sequence = stance::synthetic_walk(model, &params, request)?;
     let mut targets = stance_points(model, &sequence);
     let prefix = format!("walk-eval/{robot}/{}/{run}", std::process::id());
     let launch = Launch {
@@ -365,9 +337,6 @@ fn run_once(
         rate_hz: None,
         urdf: args.urdf.clone(),
     };
-    let pictured = args.snapshots.as_ref().filter(|_| {
-        run == 0 && distance == args.distances[0] && affordances == args.affordances[0]
-    });
     let frames = pictured.map(|dir| dir.join(format!("frames-{robot}")));
     let mut sim_args: Vec<std::ffi::OsString> = Vec::new();
     if let Some(frames) = &frames {
@@ -462,23 +431,25 @@ fn run_once(
     };
     Ok(RunResult {
         robot: robot.to_owned(),
-        affordances,
-        distance_m: distance,
-        run,
-        success: done && verdict.fell_at_s.is_none(),
-        outcome: truth::judged_outcome(verdict.fell_at_s, &daemon_outcome),
-        sim_s,
+        record: WalkRecord {
+            affordances,
+            distance_m: distance,
+            seed: request.seed,
+            outcome: truth::judged_outcome(verdict.fell_at_s, &daemon_outcome),
+            success: done && verdict.fell_at_s.is_none(),
+            stances: sequence.len(),
+            walked_m: verdict.walked_m,
+            speed_m_s: verdict.speed_m_s(sim_s),
+            sim_s,
+            drift_m: drift.map(|(largest, _)| largest),
+            max_tilt_rad: verdict.max_tilt_rad,
+        },
         wall_s,
         final_position_error_m: end.distances(&final_target).1,
-        drift_m: drift.map(|(largest, _)| largest),
         drift_samples: drift.map_or(0, |(_, samples)| samples),
-        max_tilt_rad: verdict.max_tilt_rad,
         fell_at_s: verdict.fell_at_s,
-        stances: sequence.len(),
         stance_reached: last.stance_index,
         gait,
-        walked_m: verdict.walked_m,
-        speed_m_s: verdict.speed_m_s(sim_s),
         trace,
         balance,
     })
@@ -521,27 +492,28 @@ pub(crate) fn pair_with_truth(
     drift
 }
 
-fn row(r: &RunResult) -> String {
+fn row(result: &RunResult) -> String {
+    let r = &result.record;
     format!(
         "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{}",
-        r.robot,
-        r.gait.name(),
+        result.robot,
+        result.gait.name(),
         r.affordances.name(),
         r.distance_m,
-        r.run,
+        r.seed,
         if r.success { "ok" } else { "FAIL" },
         r.outcome,
         r.sim_s,
-        r.wall_s,
-        r.sim_s / r.wall_s,
+        result.wall_s,
+        r.sim_s / result.wall_s,
         r.walked_m,
         r.speed_m_s
             .map_or_else(|| "no step".to_owned(), |v| format!("{v:.3} m/s")),
-        r.final_position_error_m,
+        result.final_position_error_m,
         r.drift_m
             .map_or_else(|| "n/a".to_owned(), |d| format!("{d:.4} m")),
         r.max_tilt_rad,
-        r.stance_reached,
+        result.stance_reached,
         r.stances
     )
 }
@@ -552,45 +524,34 @@ fn summary(results: &[RunResult]) -> String {
     let mut out = String::from(
         "robot    affordances      distance  success  sim_s(mean)  wall_s(mean)  real-time factor  speed m/s (mean, min)\n",
     );
-    let mut groups: Vec<(&str, AffordanceSet, f64)> = Vec::new();
+    let mut robots: Vec<&str> = Vec::new();
     for r in results {
-        let key = (r.robot.as_str(), r.affordances, r.distance_m);
-        if !groups.contains(&key) {
-            groups.push(key);
+        if !robots.contains(&r.robot.as_str()) {
+            robots.push(&r.robot);
         }
     }
-    for (robot, affordances, distance) in groups {
-        let runs: Vec<_> = results
-            .iter()
-            .filter(|r| {
-                r.robot == robot && r.affordances == affordances && r.distance_m == distance
-            })
-            .collect();
-        let n = runs.len() as f64;
-        let ok = runs.iter().filter(|r| r.success).count();
-        let sim: f64 = runs.iter().map(|r| r.sim_s).sum();
-        let wall: f64 = runs.iter().map(|r| r.wall_s).sum();
-        let speeds: Vec<f64> = runs
-            .iter()
-            .filter(|r| r.success)
-            .filter_map(|r| r.speed_m_s)
-            .collect();
-        let speed = if speeds.is_empty() {
-            "-".to_owned()
-        } else {
-            let mean = speeds.iter().sum::<f64>() / speeds.len() as f64;
-            let min = speeds.iter().copied().fold(f64::INFINITY, f64::min);
-            format!("{mean:.3}, {min:.3}")
-        };
-        let _ = writeln!(
-            out,
-            "{robot:<8} {:<16} {distance:>6.1} m  {ok:>3}/{:<3} {:>11.2}  {:>12.2}  {:>16.1}  {speed}",
-            affordances.name(),
-            runs.len(),
-            sim / n,
-            wall / n,
-            sim / wall
-        );
+    for robot in robots {
+        let mine: Vec<&RunResult> = results.iter().filter(|r| r.robot == robot).collect();
+        for (group, runs) in group_by_cell(&mine, |r| &r.record) {
+            let n = runs.len() as f64;
+            let sim: f64 = runs.iter().map(|r| r.record.sim_s).sum();
+            let wall: f64 = runs.iter().map(|r| r.wall_s).sum();
+            let speed = match (group.speed_mean_m_s, group.speed_min_m_s) {
+                (Some(mean), Some(min)) => format!("{mean:.3}, {min:.3}"),
+                _ => "-".to_owned(),
+            };
+            let _ = writeln!(
+                out,
+                "{robot:<8} {:<16} {:>6.1} m  {:>3}/{:<3} {:>11.2}  {:>12.2}  {:>16.1}  {speed}",
+                group.affordances.name(),
+                group.distance_m,
+                group.done,
+                group.runs,
+                sim / n,
+                wall / n,
+                sim / wall
+            );
+        }
     }
     out
 }

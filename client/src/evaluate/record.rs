@@ -1,0 +1,248 @@
+//! One walk of the paper's evaluation matrix, and the summary of the walks of one affordance set
+//! and distance, as both matrix commands report them: `walkctl evaluate` (walkd and walk-sim as
+//! processes) and walk-bench's `physics-matrix` (in process).
+
+use serde::{Serialize, Serializer};
+use stance::{AffordanceSet, WalkRequest};
+
+/// The cells of the matrix a command walks: affordance sets × distances × runs (the command-line
+/// arguments both matrix commands share).
+#[derive(Debug, Clone, clap::Args)]
+pub struct MatrixCells {
+    /// Affordance sets.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "feet,feet+left-hand,feet+right-hand"
+    )]
+    pub affordances: Vec<AffordanceSet>,
+    /// Distances to walk (m).
+    #[arg(long, value_delimiter = ',', default_value = "1,5")]
+    pub distances: Vec<f64>,
+    /// Runs per affordance set and distance; run i uses generator seed `first_seed + i`.
+    #[arg(long, default_value_t = 10)]
+    pub runs: u64,
+    /// Seed of the first run.
+    #[arg(long, default_value_t = 0)]
+    pub first_seed: u64,
+}
+
+impl MatrixCells {
+    /// Every walk, in matrix order: affordance set, then distance, then seed. Refuses no runs,
+    /// no cells, and distances that are not positive.
+    pub fn requests(&self) -> anyhow::Result<Vec<WalkRequest>> {
+        anyhow::ensure!(self.runs > 0, "--runs must be at least 1");
+        anyhow::ensure!(
+            !self.affordances.is_empty() && !self.distances.is_empty(),
+            "--affordances and --distances need at least one value each"
+        );
+        anyhow::ensure!(
+            self.distances.iter().all(|d| d.is_finite() && *d > 0.0),
+            "--distances {:?}: must be positive numbers of metres",
+            self.distances
+        );
+        Ok(self
+            .affordances
+            .iter()
+            .flat_map(|&affordances| {
+                self.distances.iter().flat_map(move |&distance| {
+                    (0..self.runs).map(move |i| WalkRequest {
+                        distance,
+                        affordances,
+                        seed: self.first_seed + i,
+                    })
+                })
+            })
+            .collect())
+    }
+}
+
+/// What one walk of the matrix measured, however it ran.
+#[derive(Clone, Debug, Serialize)]
+pub struct WalkRecord {
+    /// Affordance set (serialised as its name).
+    #[serde(serialize_with = "affordance_name")]
+    pub affordances: AffordanceSet,
+    /// Requested distance (m).
+    pub distance_m: f64,
+    /// Generator seed (the run number of `walkctl evaluate`).
+    pub seed: u64,
+    /// `done`, `fell …`, `fault: …`, `time_limit`, …
+    pub outcome: String,
+    /// `done` and the simulator's fall rule never fired.
+    pub success: bool,
+    /// Stances in the walk.
+    pub stances: usize,
+    /// Horizontal distance the simulated soles' midpoint travelled (m).
+    pub walked_m: f64,
+    /// `walked_m` over the simulated time from the first step to the end (m/s); `None` if no
+    /// step was seen.
+    pub speed_m_s: Option<f64>,
+    /// Simulated time to the end (s).
+    pub sim_s: f64,
+    /// Largest controller-vs-simulator distance of the CoM or a sole over the walk (m); `None`
+    /// when it could not be measured.
+    pub drift_m: Option<f64>,
+    /// Largest tilt of the simulated base link from the vertical (rad).
+    pub max_tilt_rad: f64,
+}
+
+fn affordance_name<S: Serializer>(set: &AffordanceSet, serializer: S) -> Result<S::Ok, S::Error> {
+    serializer.serialize_str(set.name())
+}
+
+/// The walks of one affordance set and distance, summed up.
+#[derive(Clone, Debug, Serialize)]
+pub struct GroupSummary {
+    /// Affordance set (serialised as its name).
+    #[serde(serialize_with = "affordance_name")]
+    pub affordances: AffordanceSet,
+    /// Requested distance (m).
+    pub distance_m: f64,
+    /// Walks that succeeded.
+    pub done: usize,
+    /// Walks in all.
+    pub runs: usize,
+    /// Mean speed of the walks that succeeded (m/s).
+    pub speed_mean_m_s: Option<f64>,
+    /// Smallest speed of a walk that succeeded (m/s).
+    pub speed_min_m_s: Option<f64>,
+    /// Largest drift of a walk (m).
+    pub drift_max_m: f64,
+}
+
+/// `items` split into groups of one affordance set and distance (in the order the groups first
+/// appear), each with its summary; `record` picks an item's [`WalkRecord`].
+pub fn group_by_cell<'a, T>(
+    items: &'a [T],
+    record: impl Fn(&T) -> &WalkRecord,
+) -> Vec<(GroupSummary, Vec<&'a T>)> {
+    let mut cells: Vec<(AffordanceSet, f64)> = Vec::new();
+    for item in items {
+        let r = record(item);
+        if !cells.contains(&(r.affordances, r.distance_m)) {
+            cells.push((r.affordances, r.distance_m));
+        }
+    }
+    cells
+        .into_iter()
+        .map(|(affordances, distance_m)| {
+            let members: Vec<&T> = items
+                .iter()
+                .filter(|item| {
+                    let r = record(item);
+                    r.affordances == affordances && r.distance_m == distance_m
+                })
+                .collect();
+            let records: Vec<&WalkRecord> = members.iter().map(|item| record(item)).collect();
+            (summary(affordances, distance_m, &records), members)
+        })
+        .collect()
+}
+
+fn summary(affordances: AffordanceSet, distance_m: f64, records: &[&WalkRecord]) -> GroupSummary {
+    let speeds: Vec<f64> = records
+        .iter()
+        .filter(|r| r.success)
+        .filter_map(|r| r.speed_m_s)
+        .collect();
+    GroupSummary {
+        affordances,
+        distance_m,
+        done: records.iter().filter(|r| r.success).count(),
+        runs: records.len(),
+        speed_mean_m_s: (!speeds.is_empty())
+            .then(|| speeds.iter().sum::<f64>() / speeds.len() as f64),
+        speed_min_m_s: speeds.iter().copied().reduce(f64::min),
+        drift_max_m: records.iter().filter_map(|r| r.drift_m).fold(0.0, f64::max),
+    }
+}
+
+/// A speed for a table: `0.123` m/s to three decimals, or `-` when there is none.
+pub fn speed_cell(speed_m_s: Option<f64>) -> String {
+    speed_m_s.map_or_else(|| "-".to_owned(), |v| format!("{v:.3}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(
+        affordances: AffordanceSet,
+        distance_m: f64,
+        speed: f64,
+        success: bool,
+    ) -> WalkRecord {
+        WalkRecord {
+            affordances,
+            distance_m,
+            seed: 0,
+            outcome: if success { "done" } else { "fell" }.to_owned(),
+            success,
+            stances: 10,
+            walked_m: distance_m,
+            speed_m_s: Some(speed),
+            sim_s: 10.0,
+            drift_m: Some(speed / 10.0),
+            max_tilt_rad: 0.0,
+        }
+    }
+
+    #[test]
+    fn requests_are_in_matrix_order_and_bad_cells_are_refused() {
+        let cells = MatrixCells {
+            affordances: vec![AffordanceSet::Feet, AffordanceSet::FeetRightHand],
+            distances: vec![1.0, 5.0],
+            runs: 2,
+            first_seed: 10,
+        };
+        let requests = cells.requests().unwrap();
+        assert_eq!(requests.len(), 8);
+        assert_eq!(requests[0], WalkRequest::feet(1.0, 10));
+        assert_eq!(requests[1], WalkRequest::feet(1.0, 11));
+        assert_eq!(requests[2], WalkRequest::feet(5.0, 10));
+        assert_eq!(requests[4].affordances, AffordanceSet::FeetRightHand);
+        for bad in [
+            MatrixCells {
+                runs: 0,
+                ..cells.clone()
+            },
+            MatrixCells {
+                distances: vec![1.0, -5.0],
+                ..cells.clone()
+            },
+            MatrixCells {
+                distances: vec![f64::NAN],
+                ..cells.clone()
+            },
+            MatrixCells {
+                affordances: vec![],
+                ..cells.clone()
+            },
+        ] {
+            assert!(bad.requests().is_err(), "{bad:?} was accepted");
+        }
+    }
+
+    #[test]
+    fn groups_keep_first_seen_order_and_count_only_successes_for_speed() {
+        let records = [
+            record(AffordanceSet::Feet, 1.0, 0.2, true),
+            record(AffordanceSet::FeetLeftHand, 1.0, 0.1, true),
+            record(AffordanceSet::Feet, 1.0, 0.4, true),
+            record(AffordanceSet::Feet, 1.0, 0.9, false),
+        ];
+        let groups = group_by_cell(&records, |r| r);
+        assert_eq!(groups.len(), 2);
+        let (feet, members) = &groups[0];
+        assert_eq!(feet.affordances, AffordanceSet::Feet);
+        assert_eq!((feet.done, feet.runs, members.len()), (2, 3, 3));
+        assert!((feet.speed_mean_m_s.unwrap() - 0.3).abs() < 1e-12);
+        assert_eq!(feet.speed_min_m_s, Some(0.2));
+        assert!(
+            (feet.drift_max_m - 0.09).abs() < 1e-12,
+            "the failed walk's drift counts"
+        );
+        assert_eq!(groups[1].0.affordances, AffordanceSet::FeetLeftHand);
+    }
+}
