@@ -247,6 +247,23 @@ pub struct SimMeasurement {
     pub safety: SafetyMetrics,
 }
 
+impl SimMeasurement {
+    /// The reading of a robot at rest in `initial` with its CoM at `com`, before the first step:
+    /// no velocity, no load, no contact yet.
+    pub fn at_rest(initial: &Configuration, com: Vector3<f64>) -> Self {
+        Self {
+            q: initial.joints.clone(),
+            qd: DVector::zeros(initial.joints.len()),
+            wrenches: [[0.0; 6]; 4],
+            base_orientation: initial.base.rotation,
+            base: initial.base,
+            com,
+            contacts: [false; 4],
+            safety: SafetyMetrics::default(),
+        }
+    }
+}
+
 /// The base pose blended from the anchored feet's `candidates` by their `shares` (equal halves
 /// when both shares are zero); `None` when no foot is anchored.
 fn blend(candidates: &[Option<Isometry3<f64>>; 2], shares: &[f64; 2]) -> Option<Isometry3<f64>> {
@@ -320,17 +337,7 @@ impl KinematicSim {
     ) -> Result<Self, SimError> {
         let mut kinematics = Kinematics::new(&robot.model);
         kinematics.update(&robot.model, &initial);
-        let dof = robot.model.dof();
-        let measurement = SimMeasurement {
-            q: initial.joints.clone(),
-            qd: DVector::zeros(dof),
-            wrenches: [[0.0; 6]; 4],
-            base_orientation: initial.base.rotation,
-            base: initial.base,
-            com: kinematics.com(),
-            contacts: [false; 4],
-            safety: SafetyMetrics::default(),
-        };
+        let measurement = SimMeasurement::at_rest(&initial, kinematics.com());
         let mut sim = Self {
             robot,
             options,

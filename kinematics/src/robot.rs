@@ -246,6 +246,16 @@ struct RobotSection {
 const FLAT_TOLERANCE: f64 = 1e-6;
 
 impl Robot {
+    /// The robot of `configs/<name>.toml` in this source tree (its vendored model), for the
+    /// workspace's tests and benches; panics if it does not load.
+    pub fn vendored(name: &str) -> Robot {
+        let config = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../configs")
+            .join(format!("{name}.toml"));
+        Self::load(&config, None)
+            .unwrap_or_else(|e| panic!("vendored robot {}: {e}", config.display()))
+    }
+
     /// Loads the config file at `config`, then the robot from it (see [`Robot::from_config`]).
     pub fn load(config: &Path, urdf_override: Option<&Path>) -> Result<Robot, RobotError> {
         Self::from_config(&ConfigFile::load(config)?, urdf_override)

@@ -167,17 +167,10 @@ pub fn skeleton(robot: &Robot) -> Vec<LinkShape> {
 mod tests {
     use super::*;
 
-    fn robot(name: &str) -> Robot {
-        let config = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../configs")
-            .join(format!("{name}.toml"));
-        Robot::load(&config, None).expect("vendored robot")
-    }
-
     #[test]
     fn every_robot_is_drawn_with_limbs_soles_and_hands() {
         for name in ["armar4", "jvrc1"] {
-            let robot = robot(name);
+            let robot = Robot::vendored(name);
             let shapes = skeleton(&robot);
             let count = |part: Part| shapes.iter().filter(|s| s.part == part).count();
             assert_eq!(count(Part::Sole), 2, "{name}");
@@ -198,7 +191,7 @@ mod tests {
 
     #[test]
     fn a_sole_box_lies_on_its_sole_frame() {
-        let robot = robot("jvrc1");
+        let robot = Robot::vendored("jvrc1");
         let frame = robot.frame(EndEffector::LeftFoot);
         let sole = skeleton(&robot)
             .into_iter()

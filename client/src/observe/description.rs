@@ -105,19 +105,12 @@ fn urdf_pose(pose: &Isometry3<f64>) -> Pose {
 mod tests {
     use super::*;
 
-    fn robot(name: &str) -> Robot {
-        let config = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../configs")
-            .join(format!("{name}.toml"));
-        Robot::load(&config, None).expect("vendored robot")
-    }
-
     /// The description loads as a model with the same links and joints, references no file, and
     /// draws every shape of the skeleton.
     #[test]
     fn the_description_is_the_same_model_without_meshes() {
         for name in ["armar4", "jvrc1"] {
-            let robot = robot(name);
+            let robot = Robot::vendored(name);
             let text = description_urdf(&robot).unwrap();
             assert!(
                 !text.contains("filename"),

@@ -119,10 +119,7 @@ mod tests {
     use std::collections::HashMap;
 
     fn robot(name: &str) -> Arc<Robot> {
-        let config = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../configs")
-            .join(format!("{name}.toml"));
-        Arc::new(Robot::load(&config, None).expect("vendored robot"))
+        Arc::new(Robot::vendored(name))
     }
 
     /// Composing the tree's edges from `world` gives every link's forward-kinematics pose.

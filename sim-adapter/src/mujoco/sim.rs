@@ -9,9 +9,7 @@ use kinematics::configuration::Configuration;
 use kinematics::ground::{SupportPolygon, sole_corners};
 use kinematics::robot::{EndEffector, Robot};
 use mujoco_rs::prelude::{MjData, MjModel, MjtObjBase, MjtWarning};
-use nalgebra::{
-    DVector, Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3,
-};
+use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 use super::bodies::RigidBodies;
 use super::contact::{self, FootContacts, FootIds};
@@ -77,7 +75,6 @@ impl MujocoSim {
     ) -> Result<Self, MujocoError> {
         check_library_version()?;
         check_options(&options)?;
-        let dof = robot.model.dof();
         check_joint_vector(&robot.model, "initial.joints", initial.joints.as_slice())?;
         let base = &initial.base;
         if !(base
@@ -99,16 +96,7 @@ impl MujocoSim {
             .map_err(|error| MujocoError::Compile(error.to_string()))?;
         let layout = Layout::resolve(&model, &robot, &bodies)?;
         let data = MjData::new(Box::new(model));
-        let measurement = SimMeasurement {
-            q: initial.joints.clone(),
-            qd: DVector::zeros(dof),
-            wrenches: [[0.0; 6]; 4],
-            base_orientation: initial.base.rotation,
-            base: initial.base,
-            com: Vector3::zeros(),
-            contacts: [false; 4],
-            safety: SafetyMetrics::default(),
-        };
+        let measurement = SimMeasurement::at_rest(initial, Vector3::zeros());
         let mut sim = Self {
             robot,
             options,
