@@ -7,7 +7,7 @@
 //! the daemon finished with the simulated robot on the floor is reported as a fall.
 
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{Context, bail};
 use kinematics::ConfigFile;
@@ -18,9 +18,9 @@ use stance::{Gait, WalkRequest};
 
 use crate::daemon_client::connect_when_fresh;
 use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
-use crate::evaluate::balance::BalanceRecorder;
-use crate::evaluate::truth::{TruthRecorder, Verdict, judged_outcome};
-use crate::observe::{Recorder, RecorderOutcome};
+use crate::evaluate::truth::judged_outcome;
+use crate::evaluate::watch::{WatchOptions, watch_walk};
+use crate::observe::RecorderOutcome;
 use crate::process::{Launch, Processes, executable_dir};
 use crate::watch::StanceProgress;
 
@@ -220,9 +220,6 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     let robot = std::sync::Arc::new(Robot::from_config(&file, args.urdf.as_deref())?);
     let gait = Gait::chosen_or_configured(args.gait, &file)?;
     let sequence = walk_sequence(&robot, &file, args.distance, args.seed, gait)?;
-    let (json, stance_count) = (sequence.to_json_string(), sequence.len());
-    let mut targets = crate::evaluate::stance_points(&robot, &sequence);
-
     let mut children = Processes::default();
     let running = DaemonClient::connect(&prefix).is_ok_and(|client| client.is_running());
     if !running {
@@ -238,60 +235,27 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         children.0.push(launch.walk_sim(args.physics, &[])?);
     }
     let client = connect_when_fresh(&prefix, &children.0, Duration::from_secs(20))?;
-    let observer = args
-        .record
-        .as_ref()
-        .map(|dir| {
-            let file = dir.join(format!("demo-{}.mcap", args.robot.name()));
-            Recorder::start(&prefix, std::sync::Arc::clone(&robot), &file)
-        })
-        .transpose()?;
-    let recorder = TruthRecorder::start(&prefix)?;
-    let balance = (gait == Gait::Dynamic && args.plots.is_some())
-        .then(|| BalanceRecorder::start(&prefix))
-        .transpose()?;
-    let start = client.status()?;
-    crate::evaluate::align_targets(
-        &mut targets,
-        &sequence,
-        &[
-            crate::evaluate::pose_of(&start.left_foot),
-            crate::evaluate::pose_of(&start.right_foot),
-        ],
-    );
-    let wall = Instant::now();
-    let submitted_ns = shm_types::monotonic_ns();
-    let id = client.submit_json(&json)?;
     let progress = (!args.json).then(StanceProgress::new);
-    let timeout = Duration::from_secs(60 + 30 * stance_count as u64);
-    let (mut trace, mut status_times) = (Vec::new(), Vec::new());
-    let last = client.wait_for_sequence(id, timeout, |status| {
-        if let Some(progress) = &progress {
-            progress.update(status);
-        }
-        if args.plots.is_some() && status.sequence_id == id {
-            trace.push(crate::evaluate::sample(status, &start, &targets));
-            status_times.push(status.timestamp_ns);
-        }
-    })?;
+    let options = WatchOptions {
+        record: args
+            .record
+            .as_ref()
+            .map(|dir| dir.join(format!("demo-{}.mcap", args.robot.name()))),
+        balance: gait == Gait::Dynamic && args.plots.is_some(),
+        timeout: Duration::from_secs(60 + 30 * sequence.len() as u64),
+        on_status: &|status| {
+            if let Some(progress) = &progress {
+                progress.update(status);
+            }
+        },
+    };
+    let walk = watch_walk(&client, &prefix, &robot, &sequence, &options)?;
     if let Some(progress) = &progress {
         progress.finish();
     }
-    let wall_s = wall.elapsed().as_secs_f64();
-    // Let a final status with the complete tick statistics arrive.
-    let status = client.status().unwrap_or(last);
     drop(client);
-    let recording = observer.map(Recorder::finish).transpose()?;
-    let states = recorder.finish()?;
-    let verdict = Verdict::of(&states, submitted_ns);
-    let balance = match balance {
-        Some(recorder) => recorder.finish(start.ticks, start.rate_hz)?,
-        None => Vec::new(),
-    };
-    let sim_s = last.ticks.saturating_sub(start.ticks) as f64 / last.rate_hz;
     let plot = match &args.plots {
         Some(dir) => {
-            crate::evaluate::pair_with_truth(&mut trace, &status_times, &states);
             std::fs::create_dir_all(dir)?;
             let file = dir.join(format!("fig6-{}.svg", args.robot.name()));
             let title = format!(
@@ -301,7 +265,7 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
                 args.physics.name(),
                 gait.name()
             );
-            crate::evaluate::write_fig6(&file, &title, &trace, &balance)?;
+            crate::evaluate::write_fig6(&file, &title, &walk.trace, &walk.balance)?;
             Some(file)
         }
         None => None,
@@ -310,21 +274,24 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     if !problems.is_empty() {
         bail!("shutting down: {}", problems.join("; "));
     }
+    let status = walk.settled;
     let stances = if status.state == DaemonState::Done {
         status.stance_count
     } else {
         status.stance_index
     };
+    let verdict = walk.verdict;
+    let sim_s = walk.sim_s;
     Ok(DemoOutcome {
-        distance_m: feet_midpoint(&status)[0] - feet_midpoint(&start)[0],
+        distance_m: feet_midpoint(&status)[0] - feet_midpoint(&walk.start)[0],
         stances,
         sim_s,
-        wall_s,
+        wall_s: walk.wall_s,
         gait,
         speed_m_s: verdict.and_then(|v| v.speed_m_s(sim_s)),
         fell_at_s: verdict.and_then(|v| v.fell_at_s),
         max_tilt_rad: verdict.map(|v| v.max_tilt_rad),
-        recording,
+        recording: walk.recording,
         plot,
         status,
     })

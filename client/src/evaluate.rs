@@ -21,13 +21,15 @@ pub mod fig6;
 pub mod filmstrip;
 pub mod record;
 pub(crate) mod truth;
+pub(crate) mod watch;
 
 pub use fig6::{BalanceSample, write_fig6};
 pub use record::{GroupSummary, MatrixCells, WalkRecord, group_by_cell, speed_cell};
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::sync::Arc;
+use std::time::Duration;
 
 use anyhow::{Context, bail};
 use kinematics::ConfigFile;
@@ -42,6 +44,7 @@ use stance::{AffordanceSet, Gait, PostProcessedSequence, WalkRequest};
 
 use crate::daemon_client::connect_when_fresh;
 use crate::process::{Launch, executable_dir};
+use watch::{WatchOptions, watch_walk};
 
 /// Arguments of `walkctl evaluate`.
 #[derive(Debug, clap::Args)]
@@ -254,8 +257,10 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
     let mut results = Vec::new();
     for robot in &args.robots {
         let config = args.config_dir.join(format!("{robot}.toml"));
-        let model = Robot::load(&config, args.urdf.as_deref())
-            .with_context(|| format!("robot `{robot}` ({})", config.display()))?;
+        let model = Arc::new(
+            Robot::load(&config, args.urdf.as_deref())
+                .with_context(|| format!("robot `{robot}` ({})", config.display()))?,
+        );
         for (i, request) in requests.iter().enumerate() {
             let pictured = args.snapshots.as_deref().filter(|_| i == 0);
             let result =
@@ -313,7 +318,7 @@ fn plot_robot(dir: &Path, robot: &str, results: &[RunResult]) -> anyhow::Result<
 fn run_once(
     args: &EvaluateArgs,
     robot: &str,
-    model: &Robot,
+    model: &Arc<Robot>,
     config: &Path,
     request: &WalkRequest,
     pictured: Option<&Path>,
@@ -327,7 +332,6 @@ fn run_once(
         seed: run,
     } = request;
     let sequence = stance::synthetic_walk(model, &params, request)?;
-    let mut targets = stance_points(model, &sequence);
     let prefix = format!("walk-eval/{robot}/{}/{run}", std::process::id());
     let launch = Launch {
         bin_dir: executable_dir()?,
@@ -351,61 +355,31 @@ fn run_once(
         launch.walk_sim(args.physics, &sim_args)?,
     ];
     let client = connect_when_fresh(&prefix, &processes, Duration::from_secs(30))?;
-    let observer = args
-        .record
-        .as_ref()
-        .map(|dir| {
-            let file = dir.join(format!(
+    let options = WatchOptions {
+        record: args.record.as_ref().map(|dir| {
+            dir.join(format!(
                 "{robot}-{}-{distance}m-run{run}.mcap",
                 affordances.name()
-            ));
-            crate::observe::Recorder::start(&prefix, std::sync::Arc::new(model.clone()), &file)
-        })
-        .transpose()?;
-    let recorder = truth::TruthRecorder::start(&prefix)?;
-    let balance = (gait == Gait::Dynamic)
-        .then(|| balance::BalanceRecorder::start(&prefix))
-        .transpose()?;
-    let start = client.status()?;
-    align_targets(
-        &mut targets,
-        &sequence,
-        &[pose_of(&start.left_foot), pose_of(&start.right_foot)],
-    );
-    let wall = Instant::now();
-    let submitted_ns = shm_types::monotonic_ns();
-    let id = client.submit_json(&sequence.to_json_string())?;
-    let mut trace = Vec::new();
-    let mut status_times = Vec::new();
-    let timeout = Duration::from_secs(120 + 60 * sequence.len() as u64);
-    let last = client.wait_for_sequence(id, timeout, |status| {
-        if status.sequence_id == id {
-            trace.push(sample(status, &start, &targets));
-            status_times.push(status.timestamp_ns);
-        }
-    })?;
-    let wall_s = wall.elapsed().as_secs_f64();
-    drop(client);
-    if let Some(observer) = observer {
-        observer.finish()?;
-    }
-    let states = recorder.finish()?;
-    let balance = match balance {
-        Some(recorder) => recorder.finish(start.ticks, start.rate_hz)?,
-        None => Vec::new(),
+            ))
+        }),
+        balance: gait == Gait::Dynamic,
+        timeout: Duration::from_secs(120 + 60 * sequence.len() as u64),
+        on_status: &|_| {},
     };
+    let walk = watch_walk(&client, &prefix, model, &sequence, &options)?;
+    drop(client);
     let [walkd, sim] = processes;
     let walkd_log = walkd.stop()?.log;
     let sim_log = sim.stop()?.log;
-    let Some(verdict) = truth::Verdict::of(&states, submitted_ns) else {
+    let Some(verdict) = walk.verdict else {
         bail!(
             "walk-sim published no simulator truth on `{prefix}/sim-truth`\n\
              walk-sim's log:\n{sim_log}\nwalkd's log:\n{walkd_log}"
         );
     };
     if let (Some(dir), Some(frames)) = (pictured, &frames) {
-        let start = truth::state_at(&states, submitted_ns).map_or(0.0, |s| s.sim_time_s);
-        let end = truth::state_at(&states, last.timestamp_ns)
+        let start = truth::state_at(&walk.states, walk.submitted_ns).map_or(0.0, |s| s.sim_time_s);
+        let end = truth::state_at(&walk.states, walk.last.timestamp_ns)
             .map_or(verdict.end.sim_time_s, |s| s.sim_time_s);
         let strip = dir.join(format!("filmstrip-{robot}.png"));
         let times = filmstrip::write_filmstrip(frames, start, end, &strip)?;
@@ -419,11 +393,10 @@ fn run_once(
                 .join(", ")
         );
     }
-    let drift = pair_with_truth(&mut trace, &status_times, &states);
     let end = Points::from_truth(&verdict.end);
-    let final_target = targets[targets.len() - 1];
+    let final_target = walk.targets[walk.targets.len() - 1];
+    let last = &walk.last;
     let done = last.state == DaemonState::Done;
-    let sim_s = (last.ticks - start.ticks) as f64 / last.rate_hz;
     let daemon_outcome = if done {
         "done".to_owned()
     } else {
@@ -439,19 +412,19 @@ fn run_once(
             success: done && verdict.fell_at_s.is_none(),
             stances: sequence.len(),
             walked_m: verdict.walked_m,
-            speed_m_s: verdict.speed_m_s(sim_s),
-            sim_s,
-            drift_m: drift.map(|(largest, _)| largest),
+            speed_m_s: verdict.speed_m_s(walk.sim_s),
+            sim_s: walk.sim_s,
+            drift_m: walk.drift.map(|(largest, _)| largest),
             max_tilt_rad: verdict.max_tilt_rad,
         },
-        wall_s,
+        wall_s: walk.wall_s,
         final_position_error_m: end.distances(&final_target).1,
-        drift_samples: drift.map_or(0, |(_, samples)| samples),
+        drift_samples: walk.drift.map_or(0, |(_, samples)| samples),
         fell_at_s: verdict.fell_at_s,
         stance_reached: last.stance_index,
         gait,
-        trace,
-        balance,
+        trace: walk.trace,
+        balance: walk.balance,
     })
 }
 

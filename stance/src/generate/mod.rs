@@ -6,13 +6,14 @@
 
 mod gait;
 mod impediments;
+pub(crate) mod standing;
 
 use std::fmt;
 use std::str::FromStr;
 
+use kinematics::Configuration;
 use kinematics::ik::IkError;
 use kinematics::robot::{EndEffector, Robot};
-use kinematics::{Configuration, Kinematics};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -23,6 +24,7 @@ use crate::sequence::{RawSequence, Stance};
 use crate::stance_ik::StanceIk;
 use gait::{Body, PlannedStance, Railing};
 use kinematics::ground::yaw;
+use standing::Standing;
 
 /// Pelvis height of the human the statistics describe (metres); the robot's pelvis height over
 /// it is the retargeting scale of all lengths.
@@ -168,16 +170,13 @@ pub fn generate_with_railing(
 
 /// The robot's proportions in its standing posture.
 fn measure(robot: &Robot) -> Body {
-    let model = &robot.model;
-    let mut kinematics = Kinematics::new(model);
-    kinematics.update(model, &robot.standing);
-    let pose = |e: EndEffector| kinematics.frame_pose(model, robot.frame(e));
-    let (left, right) = (pose(EndEffector::LeftFoot), pose(EndEffector::RightFoot));
-    let heading = left.rotation * Vector3::x() + right.rotation * Vector3::x();
-    let forward = Vector3::new(heading.x, heading.y, 0.0).normalize();
+    let standing = Standing::measure(robot);
+    let (left, right) = (
+        standing.pose(EndEffector::LeftFoot),
+        standing.pose(EndEffector::RightFoot),
+    );
+    let (forward, sole_z) = (standing.forward, standing.sole_z);
     let lateral = Vector3::z().cross(&forward);
-    let sole_z = 0.5 * (left.translation.z + right.translation.z);
-    let pelvis = kinematics.link_pose(robot.base_link).translation.z - sole_z;
     let unturn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -forward.y.atan2(forward.x));
     let in_path = |p: Isometry3<f64>| {
         let t = p.translation.vector;
@@ -187,13 +186,13 @@ fn measure(robot: &Robot) -> Body {
         )
     };
     Body {
-        scale: pelvis / HUMAN_PELVIS_HEIGHT,
+        scale: standing.pelvis_height / HUMAN_PELVIS_HEIGHT,
         forward,
         half_width: 0.5 * (left.translation.vector - right.translation.vector).dot(&lateral),
         sole_length: robot.sole.length,
         hands: [
-            in_path(pose(EndEffector::LeftHand)),
-            in_path(pose(EndEffector::RightHand)),
+            in_path(standing.pose(EndEffector::LeftHand)),
+            in_path(standing.pose(EndEffector::RightHand)),
         ],
     }
 }

@@ -5,7 +5,6 @@
 //! pose. Nothing is cleaned up: the raw sequence keeps the demonstrations' natural impediments
 //! (jumping contacts, toe-out, pitched soles, uneven steps) for post-processing to remove.
 
-use kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
@@ -14,6 +13,7 @@ use super::model::NgramModel;
 use super::query::{Generated, Query, Search, generate_tokens};
 use crate::environment::{Environment, HandAffordance};
 use crate::generate::AffordanceSet;
+use crate::generate::standing::Standing;
 use crate::sequence::{RawSequence, Stance};
 use crate::stance_ik::StanceIk;
 
@@ -44,20 +44,13 @@ struct RobotFrame {
 
 impl RobotFrame {
     fn measure(robot: &Robot, human_pelvis_height: f64) -> Self {
-        let model = &robot.model;
-        let mut kinematics = Kinematics::new(model);
-        kinematics.update(model, &robot.standing);
-        let pose = |e: EndEffector| kinematics.frame_pose(model, robot.frame(e));
-        let (left, right) = (pose(EndEffector::LeftFoot), pose(EndEffector::RightFoot));
-        let heading = left.rotation * Vector3::x() + right.rotation * Vector3::x();
-        let sole_z = 0.5 * (left.translation.z + right.translation.z);
-        let pelvis = kinematics.link_pose(robot.base_link).translation.z - sole_z;
+        let standing = Standing::measure(robot);
         Self {
-            scale: pelvis / human_pelvis_height,
-            forward: Vector3::new(heading.x, heading.y, 0.0).normalize(),
+            scale: standing.pelvis_height / human_pelvis_height,
+            forward: standing.forward,
             hand_rotations: [
-                pose(EndEffector::LeftHand).rotation,
-                pose(EndEffector::RightHand).rotation,
+                standing.pose(EndEffector::LeftHand).rotation,
+                standing.pose(EndEffector::RightHand).rotation,
             ],
         }
     }

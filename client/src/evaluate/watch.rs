@@ -1,0 +1,124 @@
+//! One post-processed sequence submitted to a running walkd and watched to its end from beside
+//! it: the status stream as a Fig. 6 trace, the simulator's truth, the dynamic gait's balance
+//! telemetry and, if asked, an MCAP recording. `walkctl evaluate` and `walkctl demo` both walk
+//! through here.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use kinematics::robot::Robot;
+use shm_types::{DaemonStatus, SimTruth};
+use stance::PostProcessedSequence;
+
+use super::balance::BalanceRecorder;
+use super::truth::{TruthRecorder, Verdict};
+use super::{BalanceSample, Points, TraceSample, align_targets, pair_with_truth, pose_of, sample};
+use crate::daemon_client::DaemonClient;
+use crate::observe::{Recorder, RecorderOutcome};
+
+/// What to record besides the status stream and the simulator's truth.
+pub(crate) struct WatchOptions<'a> {
+    /// Record the walk (an observer beside walkd) to this MCAP file.
+    pub record: Option<PathBuf>,
+    /// Record the dynamic gait's ZMP and DCM telemetry.
+    pub balance: bool,
+    /// How long the walk may take before it counts as stuck.
+    pub timeout: Duration,
+    /// Called with every status while the walk runs (e.g. a progress line).
+    pub on_status: &'a dyn Fn(&DaemonStatus),
+}
+
+/// What watching one walk recorded.
+pub(crate) struct WatchedWalk {
+    /// The status before submission: the walk's clock origin.
+    pub start: DaemonStatus,
+    /// The walk's last status.
+    pub last: DaemonStatus,
+    /// A status asked for after the end, with the complete tick statistics (`last` if none
+    /// came).
+    pub settled: DaemonStatus,
+    /// Wall time from submission to the end (s).
+    pub wall_s: f64,
+    /// Simulated (control-tick) time from submission to the end (s).
+    pub sim_s: f64,
+    /// Monotonic time of the submission (ns).
+    pub submitted_ns: u64,
+    /// Every state the simulator published meanwhile.
+    pub states: Vec<SimTruth>,
+    /// The simulator's verdict; `None` when no simulator published its truth (a real robot).
+    pub verdict: Option<Verdict>,
+    /// The stances' targets in the world (as the controller aligned the sequence).
+    pub targets: Vec<Points>,
+    /// The walk's statuses as a Fig. 6 trace, with the simulator's truth where it pairs.
+    pub trace: Vec<TraceSample>,
+    /// Largest controller-vs-simulator CoM or sole distance (m) and the statuses it is the
+    /// maximum over; `None` when no status paired with a simulator state.
+    pub drift: Option<(f64, usize)>,
+    /// The ZMP and DCM telemetry, with [`WatchOptions::balance`].
+    pub balance: Vec<BalanceSample>,
+    /// The recording, with [`WatchOptions::record`].
+    pub recording: Option<RecorderOutcome>,
+}
+
+/// Submits `sequence` to the walkd `client` talks to on `prefix` and watches it to its end.
+pub(crate) fn watch_walk(
+    client: &DaemonClient,
+    prefix: &str,
+    robot: &Arc<Robot>,
+    sequence: &PostProcessedSequence,
+    options: &WatchOptions,
+) -> anyhow::Result<WatchedWalk> {
+    let observer = options
+        .record
+        .as_ref()
+        .map(|file| Recorder::start(prefix, Arc::clone(robot), file))
+        .transpose()?;
+    let recorder = TruthRecorder::start(prefix)?;
+    let balance = options
+        .balance
+        .then(|| BalanceRecorder::start(prefix))
+        .transpose()?;
+    let start = client.status()?;
+    let mut targets = super::stance_points(robot, sequence);
+    align_targets(
+        &mut targets,
+        sequence,
+        &[pose_of(&start.left_foot), pose_of(&start.right_foot)],
+    );
+    let wall = Instant::now();
+    let submitted_ns = shm_types::monotonic_ns();
+    let id = client.submit_json(&sequence.to_json_string())?;
+    let (mut trace, mut status_times) = (Vec::new(), Vec::new());
+    let last = client.wait_for_sequence(id, options.timeout, |status| {
+        (options.on_status)(status);
+        if status.sequence_id == id {
+            trace.push(sample(status, &start, &targets));
+            status_times.push(status.timestamp_ns);
+        }
+    })?;
+    let wall_s = wall.elapsed().as_secs_f64();
+    let settled = client.status().unwrap_or(last);
+    let recording = observer.map(Recorder::finish).transpose()?;
+    let states = recorder.finish()?;
+    let balance = match balance {
+        Some(recorder) => recorder.finish(start.ticks, start.rate_hz)?,
+        None => Vec::new(),
+    };
+    let drift = pair_with_truth(&mut trace, &status_times, &states);
+    Ok(WatchedWalk {
+        sim_s: last.ticks.saturating_sub(start.ticks) as f64 / last.rate_hz,
+        verdict: Verdict::of(&states, submitted_ns),
+        start,
+        last,
+        settled,
+        wall_s,
+        submitted_ns,
+        states,
+        targets,
+        trace,
+        drift,
+        balance,
+        recording,
+    })
+}
