@@ -505,9 +505,15 @@ impl KinematicSim {
         self.com_acceleration += (raw - self.com_acceleration) * blend;
         let acceleration = self.com_acceleration;
         let height = com.z - self.options.ground_height;
-        let mut zmp = com - acceleration * (height / GRAVITY);
+        // The ground carries m (g + z̈); with none to carry (the CoM falling faster than g) the
+        // feet are unloaded and the ZMP is undefined: keep it under the CoM.
+        let support = GRAVITY + acceleration.z;
+        if support <= 0.0 {
+            return (*com, 0.0);
+        }
+        let mut zmp = com - acceleration * (height / support);
         zmp.z = com.z;
-        (zmp, mass * (GRAVITY + acceleration.z).max(0.0))
+        (zmp, mass * support)
     }
 
     /// Forces, metrics and the measurement record of the new state, `dt` after the last.

@@ -229,7 +229,7 @@ fn a_dynamic_walk_is_judged_by_the_zmp_of_its_com_motion() {
         }
         let n = coms.len();
         let acceleration = (coms[n - 1] - 2.0 * coms[n - 2] + coms[n - 3]) / (dt * dt);
-        let zmp = coms[n - 1].x - acceleration.x * coms[n - 1].z / GRAVITY;
+        let zmp = coms[n - 1].x - acceleration.x * coms[n - 1].z / (GRAVITY + acceleration.z);
         // The resultant of the synthetic wrenches acts at that ZMP with m (g + z̈).
         let (_, moment, normal) = feet_resultant(&robot, &sim);
         let weight = robot.model.total_mass() * (GRAVITY + acceleration.z);
