@@ -80,16 +80,7 @@ impl Kinematics {
     /// # Panics
     /// If `q.joints` does not have `model.dof()` entries or the workspace was built for another model.
     pub fn update(&mut self, model: &Model, q: &Configuration) {
-        assert_eq!(
-            q.joints.len(),
-            model.dof(),
-            "Kinematics::update: wrong joint count"
-        );
-        assert_eq!(
-            self.poses.len(),
-            model.link_count(),
-            "Kinematics::update: workspace of another model"
-        );
+        self.assert_fits(model, q, "Kinematics::update");
         let bodies = model.bodies();
         for (i, body) in bodies.iter().enumerate() {
             let pose = self.place_link(body, q);
@@ -121,16 +112,7 @@ impl Kinematics {
     /// If `q.joints` does not have `model.dof()` entries, or the workspace or `frames` was built
     /// for another model.
     pub fn update_frames(&mut self, model: &Model, q: &Configuration, frames: &FrameSet) {
-        assert_eq!(
-            q.joints.len(),
-            model.dof(),
-            "Kinematics::update_frames: wrong joint count"
-        );
-        assert_eq!(
-            self.poses.len(),
-            model.link_count(),
-            "Kinematics::update_frames: workspace of another model"
-        );
+        self.assert_fits(model, q, "Kinematics::update_frames");
         assert_eq!(
             frames.link_count,
             model.link_count(),
@@ -140,6 +122,16 @@ impl Kinematics {
         for &link in &frames.links {
             self.poses[link] = self.place_link(&bodies[link], q);
         }
+    }
+
+    /// Panics, naming `caller`, unless `q` and this workspace are of `model`.
+    fn assert_fits(&self, model: &Model, q: &Configuration, caller: &str) {
+        assert_eq!(q.joints.len(), model.dof(), "{caller}: wrong joint count");
+        assert_eq!(
+            self.poses.len(),
+            model.link_count(),
+            "{caller}: workspace of another model"
+        );
     }
 
     /// World pose of `body` from its parent's (already updated) pose and its joint value; records

@@ -73,6 +73,7 @@ mod tests {
     use nalgebra::UnitQuaternion;
 
     use super::*;
+    use crate::controller::trajectory::assert_velocity_is_derivative;
 
     fn swing() -> (
         SwingTrajectory,
@@ -130,17 +131,8 @@ mod tests {
     #[test]
     fn the_velocity_is_the_derivative_of_the_pose() {
         let (swing, ..) = swing();
-        let h = 1e-6;
         for t in [0.1, 0.25, 0.31, 0.45] {
-            let (a, _) = swing.sample(t - h);
-            let (b, _) = swing.sample(t + h);
-            let (_, v) = swing.sample(t);
-            let linear = (b.translation.vector - a.translation.vector) / (2.0 * h);
-            let angular = (b.rotation * a.rotation.inverse()).scaled_axis() / (2.0 * h);
-            for k in 0..3 {
-                assert!((linear[k] - v[k]).abs() < 1e-6, "t {t} linear {k}");
-                assert!((angular[k] - v[3 + k]).abs() < 1e-6, "t {t} angular {k}");
-            }
+            assert_velocity_is_derivative(|t| swing.sample(t), t);
         }
     }
 }
