@@ -68,8 +68,8 @@ const COMMANDS: &str = "commands";
 const STATUS: &str = "status";
 const STANCES: &str = "stances";
 const CONTROL: &str = "control";
-pub(crate) const SIM_TRUTH: &str = "sim-truth";
-pub(crate) const TELEMETRY: &str = "telemetry";
+const SIM_TRUTH: &str = "sim-truth";
+const TELEMETRY: &str = "telemetry";
 
 impl ServiceNames {
     /// Names under `prefix` (e.g. `walk/armar4`); fails if a resulting name is not a valid
@@ -206,8 +206,25 @@ fn not_running(service: &str) -> ShmError {
     }
 }
 
-/// A payload that travels on a high-rate stream of its own; the type names the stream, so a port
-/// cannot open a stream with the wrong payload.
+/// A message type with a publish-subscribe service of its own: the type names the service and
+/// fixes its settings, so a port cannot open a service with the wrong payload and every role opens
+/// it with the same settings. Every such service keeps the newest message for a late subscriber
+/// and drops a subscriber's oldest message when its buffer is full.
+pub(crate) trait Topic: core::fmt::Debug + ZeroCopySend + Copy + Default + 'static {
+    /// The service's kind: the last part of its name.
+    const KIND: &'static str;
+    /// Messages a subscriber may buffer before the oldest is dropped.
+    const BUFFER: usize;
+    /// Subscribers the service admits.
+    const SUBSCRIBERS: usize;
+    /// Publishers the service admits: the one that serves it and one restarting.
+    const PUBLISHERS: usize = 2;
+    /// Messages a subscriber may hold at once.
+    const BORROWED: usize = 2;
+}
+
+/// A payload that travels on a high-rate stream of its own (sensors, commands), accompanied by a
+/// wake-up event of the same name.
 pub(crate) trait StreamPayload:
     core::fmt::Debug + ZeroCopySend + Copy + Default + 'static
 {
@@ -223,25 +240,66 @@ impl StreamPayload for JointCommand {
     const KIND: &'static str = COMMANDS;
 }
 
-/// The stream that carries `T` (sensors, commands): newest wins, a late subscriber gets the last
-/// one. Its subscribers may buffer up to [`STREAM_OBSERVER_BUFFER`] messages (observers); the
-/// peers subscribe with [`STREAM_PEER_BUFFER`].
-pub(crate) fn stream<T: StreamPayload>(
+/// A stream: its subscribers may buffer up to [`STREAM_OBSERVER_BUFFER`] messages (observers);
+/// the peers subscribe with [`STREAM_PEER_BUFFER`].
+impl<T: StreamPayload> Topic for T {
+    const KIND: &'static str = <T as StreamPayload>::KIND;
+    const BUFFER: usize = STREAM_OBSERVER_BUFFER;
+    const SUBSCRIBERS: usize = capacity::STREAM_SUBSCRIBERS;
+    const PUBLISHERS: usize = capacity::STREAM_PUBLISHERS;
+    const BORROWED: usize = 4;
+}
+
+/// The daemon's status: a client needs only the newest.
+impl Topic for DaemonStatus {
+    const KIND: &'static str = STATUS;
+    const BUFFER: usize = 2;
+    const SUBSCRIBERS: usize = capacity::STATUS_SUBSCRIBERS;
+}
+
+/// Messages of `sim-truth` a subscriber can hold before the oldest is dropped: 0.5 s of samples
+/// at 2 kHz, or about 70 ms of a lockstep run going 15 000 samples per wall second.
+pub const SIM_TRUTH_BUFFER: usize = 1024;
+
+/// The simulator's ground truth: published with every sample, read by evaluation clients that
+/// drain it continuously.
+impl Topic for SimTruth {
+    const KIND: &'static str = SIM_TRUTH;
+    const BUFFER: usize = SIM_TRUTH_BUFFER;
+    const SUBSCRIBERS: usize = capacity::STREAM_SUBSCRIBERS;
+}
+
+/// The control thread's per-tick telemetry: published by walkd, drained by observers.
+impl Topic for Telemetry {
+    const KIND: &'static str = TELEMETRY;
+    const BUFFER: usize = TELEMETRY_BUFFER;
+    const SUBSCRIBERS: usize = capacity::TELEMETRY_SUBSCRIBERS;
+}
+
+/// Opens the service of `T` under `names` (creating it first if `access` allows) with the
+/// settings `T` fixes.
+pub(crate) fn publish_subscribe<T: Topic>(
     node: &IpcNode,
     names: &ServiceNames,
+    access: Access,
 ) -> Result<PubSub<T>, ShmError> {
     let service = names.full(T::KIND);
-    node.service_builder(&names.service_name(T::KIND)?)
+    let builder = node
+        .service_builder(&names.service_name(T::KIND)?)
         .publish_subscribe::<T>()
         .enable_safe_overflow(true)
         .history_size(1)
-        .subscriber_max_buffer_size(STREAM_OBSERVER_BUFFER)
-        .subscriber_max_borrowed_samples(4)
-        .max_publishers(capacity::STREAM_PUBLISHERS)
-        .max_subscribers(capacity::STREAM_SUBSCRIBERS)
-        .max_nodes(capacity::NODES)
-        .open_or_create()
-        .map_err(|e| pubsub_error(&service, e))
+        .subscriber_max_buffer_size(T::BUFFER)
+        .subscriber_max_borrowed_samples(T::BORROWED)
+        .max_publishers(T::PUBLISHERS)
+        .max_subscribers(T::SUBSCRIBERS)
+        .max_nodes(capacity::NODES);
+    match access {
+        Access::OpenOrCreate => builder
+            .open_or_create()
+            .map_err(|e| pubsub_error(&service, e)),
+        Access::OpenOnly => builder.open().map_err(|e| pubsub_open_error(&service, e)),
+    }
 }
 
 /// The wake-up event that accompanies the stream of `T`.
@@ -257,74 +315,6 @@ pub(crate) fn stream_event<T: StreamPayload>(
         .max_nodes(capacity::NODES)
         .open_or_create()
         .map_err(|e: EventOpenOrCreateError| ShmError::ipc("open or create event", &service, e))
-}
-
-pub(crate) fn status(
-    node: &IpcNode,
-    names: &ServiceNames,
-    access: Access,
-) -> Result<PubSub<DaemonStatus>, ShmError> {
-    let service = names.full(STATUS);
-    let builder = node
-        .service_builder(&names.service_name(STATUS)?)
-        .publish_subscribe::<DaemonStatus>()
-        .enable_safe_overflow(true)
-        .history_size(1)
-        .subscriber_max_buffer_size(2)
-        .subscriber_max_borrowed_samples(2)
-        .max_publishers(2)
-        .max_subscribers(capacity::STATUS_SUBSCRIBERS)
-        .max_nodes(capacity::NODES);
-    match access {
-        Access::OpenOrCreate => builder
-            .open_or_create()
-            .map_err(|e| pubsub_error(&service, e)),
-        Access::OpenOnly => builder.open().map_err(|e| pubsub_open_error(&service, e)),
-    }
-}
-
-/// Messages of `sim-truth` a subscriber can hold before the oldest is dropped: 0.5 s of samples
-/// at 2 kHz, or about 70 ms of a lockstep run going 15 000 samples per wall second.
-pub const SIM_TRUTH_BUFFER: usize = 1024;
-
-/// The simulator's ground truth: published with every sample, read by evaluation clients that
-/// drain it continuously. Both sides open or create it, so either may start first.
-pub(crate) fn sim_truth(
-    node: &IpcNode,
-    names: &ServiceNames,
-) -> Result<PubSub<SimTruth>, ShmError> {
-    let service = names.full(SIM_TRUTH);
-    node.service_builder(&names.service_name(SIM_TRUTH)?)
-        .publish_subscribe::<SimTruth>()
-        .enable_safe_overflow(true)
-        .history_size(1)
-        .subscriber_max_buffer_size(SIM_TRUTH_BUFFER)
-        .subscriber_max_borrowed_samples(2)
-        .max_publishers(2)
-        .max_subscribers(capacity::STREAM_SUBSCRIBERS)
-        .max_nodes(capacity::NODES)
-        .open_or_create()
-        .map_err(|e| pubsub_error(&service, e))
-}
-
-/// The control thread's per-tick telemetry: published by walkd, drained by observers. Both sides
-/// open or create it, so either may start first.
-pub(crate) fn telemetry(
-    node: &IpcNode,
-    names: &ServiceNames,
-) -> Result<PubSub<Telemetry>, ShmError> {
-    let service = names.full(TELEMETRY);
-    node.service_builder(&names.service_name(TELEMETRY)?)
-        .publish_subscribe::<Telemetry>()
-        .enable_safe_overflow(true)
-        .history_size(1)
-        .subscriber_max_buffer_size(TELEMETRY_BUFFER)
-        .subscriber_max_borrowed_samples(2)
-        .max_publishers(2)
-        .max_subscribers(capacity::TELEMETRY_SUBSCRIBERS)
-        .max_nodes(capacity::NODES)
-        .open_or_create()
-        .map_err(|e| pubsub_error(&service, e))
 }
 
 /// Opens a client → daemon request-response service: few clients, one answer per request.
@@ -411,7 +401,8 @@ mod tests {
         let prefix = format!("walk-test/shm-types/mismatch/{}", std::process::id());
         let names = ServiceNames::new(&prefix).unwrap();
         let (node, _) = create_node("v0-peer").unwrap();
-        let _old = stream::<OldSensorSample>(&node, &names).unwrap();
+        let _old =
+            publish_subscribe::<OldSensorSample>(&node, &names, Access::OpenOrCreate).unwrap();
         match AdapterPorts::open(&names, "adapter") {
             Err(error @ ShmError::ProtocolMismatch { .. }) => {
                 assert!(error.to_string().contains(&format!("{prefix}/sensors")));

@@ -51,7 +51,7 @@ use super::sample_gate::{SampleGate, Verdict};
 use super::shared::{ControlOutcome, Shared, StartOutcome};
 use super::snapshot::SnapshotWriter;
 use super::stats::{LoopStats, MissRecord, log_histogram, record, summarize};
-use super::telemetry::{self, TickRecord};
+use super::telemetry;
 use crate::controller::{
     Command, CommandMode, Controller, ControllerState, FaultCode, PreparedSequence,
 };
@@ -439,21 +439,19 @@ impl ControlLoop {
     /// it does not stop the robot.
     fn publish_telemetry(&mut self, commanded: bool, compute_ns: u64, sent_ns: u64) {
         self.telemetry_seq += 1;
-        let record = TickRecord {
-            seq: self.telemetry_seq,
-            tick: self.stats.ticks,
-            sample_seq: self.sample.seq,
-            sample_timestamp_ns: self.sample.timestamp_ns,
-            command_seq: if commanded { self.command_seq } else { 0 },
-            sent_ns,
-            compute_ns,
-            deadline_misses: self.stats.deadline_misses,
-            state: self.daemon_state(),
-        };
+        let state = self.daemon_state();
         let controller = self.controller.telemetry();
-        let published = self
-            .ports
-            .publish_telemetry(|out| telemetry::fill(out, &record, &controller));
+        let published = self.ports.publish_telemetry(|out| {
+            out.seq = self.telemetry_seq;
+            out.tick = self.stats.ticks;
+            out.sample_seq = self.sample.seq;
+            out.sample_timestamp_ns = self.sample.timestamp_ns;
+            out.command_seq = if commanded { self.command_seq } else { 0 };
+            out.sent_ns = sent_ns;
+            out.compute_ns = compute_ns;
+            out.deadline_misses = self.stats.deadline_misses;
+            telemetry::fill(out, state, &controller);
+        });
         if published.is_err() {
             self.stats.telemetry_failures += 1;
         }

@@ -1,45 +1,16 @@
 //! Fills the `telemetry` message of a control tick from the controller's
-//! [`ControllerTelemetry`](crate::controller::ControllerTelemetry) and the loop's bookkeeping.
-//! Allocation-free: it runs on the control thread, after the tick's command was sent.
+//! [`ControllerTelemetry`](crate::controller::ControllerTelemetry) (the loop adds its
+//! bookkeeping). Allocation-free: it runs on the control thread, after the tick's command was sent.
 
 use shm_types::{Code, DaemonState, Flag, SUPPORT_VERTICES, Telemetry, WalkPhase};
 
 use crate::controller::{ControllerTelemetry, Phase};
 
-/// The loop's side of one tick's telemetry.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct TickRecord {
-    /// Telemetry sequence number (1, 2, …).
-    pub seq: u64,
-    /// Ticks executed, this one included.
-    pub tick: u64,
-    /// The answered sample's `seq` and time stamp.
-    pub sample_seq: u64,
-    pub sample_timestamp_ns: u64,
-    /// The command sent this tick (0: none).
-    pub command_seq: u64,
-    /// When the command went out (or the tick ended).
-    pub sent_ns: u64,
-    /// Controller compute time (ns).
-    pub compute_ns: u64,
-    /// Deadline misses so far.
-    pub deadline_misses: u64,
-    /// The daemon's state after the tick.
-    pub state: DaemonState,
-}
-
-/// Writes `record` and `controller` into `out` (every field, so a reused buffer keeps nothing
-/// stale).
-pub(super) fn fill(out: &mut Telemetry, record: &TickRecord, controller: &ControllerTelemetry) {
-    out.seq = record.seq;
-    out.tick = record.tick;
-    out.sample_seq = record.sample_seq;
-    out.sample_timestamp_ns = record.sample_timestamp_ns;
-    out.command_seq = record.command_seq;
-    out.sent_ns = record.sent_ns;
-    out.compute_ns = record.compute_ns;
-    out.deadline_misses = record.deadline_misses;
-    out.state = Code::new(record.state);
+/// Writes the daemon's `state` and what the `controller` estimated and aimed at into `out`:
+/// every field but the loop's bookkeeping (`seq` to `deadline_misses`, which the loop writes), so
+/// a reused buffer keeps nothing stale.
+pub(super) fn fill(out: &mut Telemetry, state: DaemonState, controller: &ControllerTelemetry) {
+    out.state = Code::new(state);
     out.phase = Code::new(wire_phase(controller.phase));
     out.stance_index = controller.stance_index;
     out.stance_count = controller.stance_count;

@@ -9,11 +9,13 @@ use std::cell::OnceCell;
 
 use iceoryx2::pending_response::PendingResponse;
 use iceoryx2::port::client::Client;
-use iceoryx2::port::subscriber::{Subscriber, SubscriberCreateError};
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::client::ClientCreateError;
 
-use crate::services::{self, Access, ControlService, IpcNode, PubSub, SubmitService, capacity};
+use super::topic::TopicReceiver;
+use crate::services::{
+    self, Access, ControlService, IpcNode, PubSub, SubmitService, Topic, capacity,
+};
 use crate::{
     ControlCommand, ControlReply, ControlRequest, DaemonStatus, ServiceNames, ShmError, SubmitReply,
 };
@@ -21,7 +23,6 @@ use crate::{
 /// How often a waiting client looks for an answer.
 const POLL: Duration = Duration::from_millis(1);
 
-type StatusSubscriber = Subscriber<ipc::Service, DaemonStatus, ()>;
 type StancesClient = Client<ipc::Service, [u8], (), SubmitReply, ()>;
 type ControlClient = Client<ipc::Service, ControlRequest, (), ControlReply, ()>;
 
@@ -29,7 +30,7 @@ type ControlClient = Client<ipc::Service, ControlRequest, (), ControlReply, ()>;
 /// [`connect`](Self::connect) fails with [`ShmError::NotRunning`].
 pub struct ClientPorts {
     names: ServiceNames,
-    status: OnceCell<StatusSubscriber>,
+    status: OnceCell<TopicReceiver<DaemonStatus>>,
     stances: OnceCell<StancesClient>,
     control: OnceCell<ControlClient>,
     status_service: PubSub<DaemonStatus>,
@@ -45,7 +46,7 @@ impl ClientPorts {
         let (node, _) = services::create_node(node_name)?;
         let ports = Self {
             names: names.clone(),
-            status_service: services::status(&node, names, Access::OpenOnly)?,
+            status_service: services::publish_subscribe(&node, names, Access::OpenOnly)?,
             stances_service: services::stances(&node, names, Access::OpenOnly)?,
             control_service: services::control(&node, names, Access::OpenOnly)?,
             status: OnceCell::new(),
@@ -65,24 +66,9 @@ impl ClientPorts {
             && self.stances_service.dynamic_config().number_of_servers() > 0
     }
 
-    fn status_subscriber(&self) -> Result<&StatusSubscriber, ShmError> {
+    fn status_subscriber(&self) -> Result<&TopicReceiver<DaemonStatus>, ShmError> {
         created(&self.status, || {
-            self.status_service
-                .subscriber_builder()
-                .create()
-                .map_err(|e| {
-                    let service = self.names.full("status");
-                    match e {
-                        SubscriberCreateError::ExceedsMaxSupportedSubscribers => {
-                            ShmError::ServiceFull {
-                                service,
-                                port: "subscriber",
-                                limit: capacity::STATUS_SUBSCRIBERS,
-                            }
-                        }
-                        other => ShmError::ipc("create subscriber on", &service, other),
-                    }
-                })
+            TopicReceiver::subscribe(&self.names, &self.status_service, DaemonStatus::BUFFER)
         })
     }
 
@@ -109,18 +95,12 @@ impl ClientPorts {
 
     /// The newest status received since the last call, if any.
     pub fn latest_status(&self) -> Result<Option<DaemonStatus>, ShmError> {
-        let service = self.names.full("status");
         let subscriber = self.status_subscriber()?;
-        let mut latest = None;
-        while let Some(sample) = subscriber
-            .receive()
-            .map_err(|e| ShmError::ipc("receive from", &service, e))?
-        {
-            latest = Some(*sample.payload());
+        let mut status = DaemonStatus::INITIAL;
+        if !subscriber.take_latest(&mut status)? {
+            return Ok(None);
         }
-        latest
-            .map(|status| checked_status(&service, status))
-            .transpose()
+        checked_status(subscriber.name(), status).map(Some)
     }
 
     /// Waits up to `timeout` for a status newer than the last one received.

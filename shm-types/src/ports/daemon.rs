@@ -2,13 +2,16 @@
 
 use core::time::Duration;
 
-use iceoryx2::port::publisher::Publisher;
+use core::ops::Deref;
+
+use iceoryx2::active_request::ActiveRequest;
+use iceoryx2::port::ReceiveError;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
 
 use super::stream::{StreamReceiver, StreamSender};
-use super::telemetry::TelemetrySender;
-use crate::services::{self, Access, ControlService, IpcNode, PubSub, SubmitService};
+use super::topic::TopicSender;
+use crate::services::{self, Access, ControlService, IpcNode, SubmitService};
 use crate::{
     ControlCommand, ControlReply, ControlRequest, DaemonStatus, DecodeError, JointCommand,
     SensorSample, ServiceNames, ShmError, SubmitReply, Telemetry,
@@ -19,7 +22,7 @@ use crate::{
 pub struct DaemonLoopPorts {
     sensors: StreamReceiver<SensorSample>,
     commands: StreamSender<JointCommand>,
-    telemetry: TelemetrySender,
+    telemetry: TopicSender<Telemetry>,
     _node: IpcNode,
 }
 
@@ -30,7 +33,7 @@ impl DaemonLoopPorts {
         Ok(Self {
             sensors: StreamReceiver::open(&node, names)?,
             commands: StreamSender::open(&node, names)?,
-            telemetry: TelemetrySender::open(&node, names)?,
+            telemetry: TopicSender::open(&node, names, 1)?,
             _node: node,
         })
     }
@@ -68,13 +71,12 @@ impl DaemonLoopPorts {
 
 /// The service thread's ports: status out, sequence submissions and control requests in.
 pub struct DaemonServicePorts {
-    status_name: String,
     stances_name: String,
     control_name: String,
-    status: Publisher<ipc::Service, DaemonStatus, ()>,
+    status: TopicSender<DaemonStatus>,
     stances: Server<ipc::Service, [u8], (), SubmitReply, ()>,
     control: Server<ipc::Service, ControlRequest, (), ControlReply, ()>,
-    _services: (PubSub<DaemonStatus>, SubmitService, ControlService),
+    _services: (SubmitService, ControlService),
     _node: IpcNode,
     cleaned_dead_nodes: u64,
 }
@@ -83,18 +85,10 @@ impl DaemonServicePorts {
     /// Opens (or creates) `status`, `stances` and `control` under `names`.
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, cleaned_dead_nodes) = services::create_node(node_name)?;
-        let (status_name, stances_name, control_name) = (
-            names.full("status"),
-            names.full("stances"),
-            names.full("control"),
-        );
-        let status_service = services::status(&node, names, Access::OpenOrCreate)?;
+        let (stances_name, control_name) = (names.full("stances"), names.full("control"));
+        let status = TopicSender::open(&node, names, 2)?;
         let stances_service = services::stances(&node, names, Access::OpenOrCreate)?;
         let control_service = services::control(&node, names, Access::OpenOrCreate)?;
-        let status = status_service
-            .publisher_builder()
-            .create()
-            .map_err(|e| ShmError::ipc("create publisher on", &status_name, e))?;
         let stances = stances_service
             .server_builder()
             .create()
@@ -104,13 +98,12 @@ impl DaemonServicePorts {
             .create()
             .map_err(|e| ShmError::ipc("create server on", &control_name, e))?;
         Ok(Self {
-            status_name,
             stances_name,
             control_name,
             status,
             stances,
             control,
-            _services: (status_service, stances_service, control_service),
+            _services: (stances_service, control_service),
             _node: node,
             cleaned_dead_nodes,
         })
@@ -123,10 +116,7 @@ impl DaemonServicePorts {
 
     /// Publishes a status snapshot.
     pub fn publish_status(&self, status: &DaemonStatus) -> Result<(), ShmError> {
-        self.status
-            .send_copy(*status)
-            .map(|_| ())
-            .map_err(|e| ShmError::ipc("send on", &self.status_name, e))
+        self.status.send_copy(status)
     }
 
     /// Answers at most one pending submission with `handle(json_bytes)`; returns whether there
@@ -135,18 +125,7 @@ impl DaemonServicePorts {
         &self,
         handle: impl FnOnce(&[u8]) -> SubmitReply,
     ) -> Result<bool, ShmError> {
-        let Some(request) = self
-            .stances
-            .receive()
-            .map_err(|e| ShmError::ipc("receive from", &self.stances_name, e))?
-        else {
-            return Ok(false);
-        };
-        let reply = handle(request.payload());
-        request
-            .send_copy(reply)
-            .map_err(|e| ShmError::ipc("reply on", &self.stances_name, e))?;
-        Ok(true)
+        answer(&self.stances_name, self.stances.receive(), handle)
     }
 
     /// Answers at most one pending control request with `handle(command)`, where `command` is
@@ -156,17 +135,33 @@ impl DaemonServicePorts {
         &self,
         handle: impl FnOnce(Result<ControlCommand, DecodeError>) -> ControlReply,
     ) -> Result<bool, ShmError> {
-        let Some(request) = self
-            .control
-            .receive()
-            .map_err(|e| ShmError::ipc("receive from", &self.control_name, e))?
-        else {
-            return Ok(false);
-        };
-        let reply = handle(request.payload().command.get());
-        request
-            .send_copy(reply)
-            .map_err(|e| ShmError::ipc("reply on", &self.control_name, e))?;
-        Ok(true)
+        answer(&self.control_name, self.control.receive(), |request| {
+            handle(request.command.get())
+        })
     }
+}
+
+/// A request a server received and has not answered yet.
+type Received<Request, Reply> = ActiveRequest<ipc::Service, Request, (), Reply, ()>;
+
+/// Answers the request a server `received` (if any) with `handle(payload)`; returns whether
+/// there was one.
+fn answer<Request, Reply>(
+    service: &str,
+    received: Result<Option<Received<Request, Reply>>, ReceiveError>,
+    handle: impl FnOnce(&Request) -> Reply,
+) -> Result<bool, ShmError>
+where
+    Request: core::fmt::Debug + IceoryxSend + ?Sized,
+    Reply: core::fmt::Debug + ZeroCopySend,
+    Received<Request, Reply>: Deref<Target = Request>,
+{
+    let Some(request) = received.map_err(|e| ShmError::ipc("receive from", service, e))? else {
+        return Ok(false);
+    };
+    let reply = handle(&request);
+    request
+        .send_copy(reply)
+        .map_err(|e| ShmError::ipc("reply on", service, e))?;
+    Ok(true)
 }

@@ -8,10 +8,8 @@
 //! telemetries, so an observer that drains every few milliseconds loses nothing at 1 kHz; one
 //! that falls further behind loses the oldest, visible as gaps in the messages' `seq`.
 
-use iceoryx2::port::subscriber::{Subscriber, SubscriberCreateError};
-use iceoryx2::prelude::*;
-
-use crate::services::{self, Access, IpcNode, PubSub, capacity};
+use super::topic::TopicReceiver;
+use crate::services::{self, Access, IpcNode, Topic};
 use crate::{DaemonStatus, JointCommand, SensorSample, ServiceNames, ShmError, Telemetry};
 
 /// One message an observer received.
@@ -27,61 +25,13 @@ pub enum Observed<'a> {
     Status(&'a DaemonStatus),
 }
 
-/// A subscriber of one service and the service's full name (for errors).
-struct Subscription<T: core::fmt::Debug + ZeroCopySend + 'static> {
-    name: String,
-    subscriber: Subscriber<ipc::Service, T, ()>,
-    _service: PubSub<T>,
-}
-
-impl<T: core::fmt::Debug + ZeroCopySend + 'static> Subscription<T> {
-    fn new(
-        name: String,
-        service: PubSub<T>,
-        buffer: usize,
-        limit: usize,
-    ) -> Result<Self, ShmError> {
-        let subscriber = service
-            .subscriber_builder()
-            .buffer_size(buffer)
-            .create()
-            .map_err(|e| match e {
-                SubscriberCreateError::ExceedsMaxSupportedSubscribers => ShmError::ServiceFull {
-                    service: name.clone(),
-                    port: "subscriber",
-                    limit,
-                },
-                other => ShmError::ipc("create subscriber on", &name, other),
-            })?;
-        Ok(Self {
-            name,
-            subscriber,
-            _service: service,
-        })
-    }
-
-    /// Passes every message received since the last call to `each`, oldest first.
-    fn drain(&self, mut each: impl FnMut(&T)) -> Result<usize, ShmError> {
-        let mut count = 0;
-        while let Some(sample) = self
-            .subscriber
-            .receive()
-            .map_err(|e| ShmError::ipc("receive from", &self.name, e))?
-        {
-            each(sample.payload());
-            count += 1;
-        }
-        Ok(count)
-    }
-}
-
 /// A running daemon's streams, seen by an observer. Only opens what a daemon created: if no
 /// daemon serves `names`, [`open`](Self::open) fails with [`ShmError::NotRunning`].
 pub struct ObserverPorts {
-    telemetry: Subscription<Telemetry>,
-    sensors: Subscription<SensorSample>,
-    commands: Subscription<JointCommand>,
-    status: Subscription<DaemonStatus>,
+    telemetry: TopicReceiver<Telemetry>,
+    sensors: TopicReceiver<SensorSample>,
+    commands: TopicReceiver<JointCommand>,
+    status: TopicReceiver<DaemonStatus>,
     _node: IpcNode,
 }
 
@@ -91,31 +41,11 @@ impl ObserverPorts {
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, _) = services::create_node(node_name)?;
         // The status service is opened first and only opened: without a daemon this fails.
-        let status = services::status(&node, names, Access::OpenOnly)?;
-        let status = Subscription::new(
-            names.full("status"),
-            status,
-            2,
-            capacity::STATUS_SUBSCRIBERS,
-        )?;
-        let telemetry = Subscription::new(
-            names.full(services::TELEMETRY),
-            services::telemetry(&node, names)?,
-            services::TELEMETRY_BUFFER,
-            capacity::TELEMETRY_SUBSCRIBERS,
-        )?;
-        let sensors = Subscription::new(
-            names.full("sensors"),
-            services::stream::<SensorSample>(&node, names)?,
-            services::STREAM_OBSERVER_BUFFER,
-            capacity::STREAM_SUBSCRIBERS,
-        )?;
-        let commands = Subscription::new(
-            names.full("commands"),
-            services::stream::<JointCommand>(&node, names)?,
-            services::STREAM_OBSERVER_BUFFER,
-            capacity::STREAM_SUBSCRIBERS,
-        )?;
+        let status = services::publish_subscribe(&node, names, Access::OpenOnly)?;
+        let status = TopicReceiver::subscribe(names, &status, DaemonStatus::BUFFER)?;
+        let telemetry = TopicReceiver::open(&node, names, Telemetry::BUFFER)?;
+        let sensors = TopicReceiver::open(&node, names, SensorSample::BUFFER)?;
+        let commands = TopicReceiver::open(&node, names, JointCommand::BUFFER)?;
         Ok(Self {
             telemetry,
             sensors,

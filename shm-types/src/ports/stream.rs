@@ -7,87 +7,60 @@ use core::time::Duration;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::listener::ListenerWaitError;
 use iceoryx2::port::notifier::Notifier;
-use iceoryx2::port::publisher::Publisher;
-use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 
-use crate::services::{self, Event, IpcNode, PubSub, StreamPayload};
+use super::topic::{TopicReceiver, TopicSender};
+use crate::services::{self, Access, IpcNode, PubSub, StreamPayload};
 use crate::{ServiceNames, ShmError};
 
 /// Sending end: publish + notify.
 pub(crate) struct StreamSender<T: StreamPayload> {
-    service_name: String,
-    publisher: Publisher<ipc::Service, T, ()>,
+    sender: TopicSender<T>,
     notifier: Notifier<ipc::Service>,
-    _service: PubSub<T>,
-    _event: Event,
 }
 
 impl<T: StreamPayload> StreamSender<T> {
     /// Opens (or creates) the stream of `T` under `names` and its event, as their sender.
     pub(crate) fn open(node: &IpcNode, names: &ServiceNames) -> Result<Self, ShmError> {
-        let service_name = names.full(T::KIND);
-        let service = services::stream::<T>(node, names)?;
-        let event = services::stream_event::<T>(node, names)?;
-        let publisher = service
-            .publisher_builder()
-            .max_loaned_samples(2)
-            .create()
-            .map_err(|e| ShmError::ipc("create publisher on", &service_name, e))?;
-        let notifier = event
+        let sender = TopicSender::open(node, names, 2)?;
+        let notifier = services::stream_event::<T>(node, names)?
             .notifier_builder()
             .create()
-            .map_err(|e| ShmError::ipc("create notifier on", &service_name, e))?;
-        Ok(Self {
-            service_name,
-            publisher,
-            notifier,
-            _service: service,
-            _event: event,
-        })
+            .map_err(|e| ShmError::ipc("create notifier on", sender.name(), e))?;
+        Ok(Self { sender, notifier })
     }
 
     /// Fills a message in shared memory in place, sends it and wakes the listeners.
     /// No heap allocation.
     pub(crate) fn send(&self, fill: impl FnOnce(&mut T)) -> Result<(), ShmError> {
-        super::send_in_place(&self.publisher, &self.service_name, fill)?;
+        self.sender.send(fill)?;
         self.notifier
             .notify()
-            .map_err(|e| ShmError::ipc("notify on", &self.service_name, e))?;
+            .map_err(|e| ShmError::ipc("notify on", self.sender.name(), e))?;
         Ok(())
     }
 }
 
 /// Receiving end: wait for the wake-up, take the newest message.
 pub(crate) struct StreamReceiver<T: StreamPayload> {
-    service_name: String,
-    subscriber: Subscriber<ipc::Service, T, ()>,
+    receiver: TopicReceiver<T>,
     listener: Listener<ipc::Service>,
     service: PubSub<T>,
-    _event: Event,
 }
 
 impl<T: StreamPayload> StreamReceiver<T> {
     /// Opens (or creates) the stream of `T` under `names` and its event, as their receiver.
     pub(crate) fn open(node: &IpcNode, names: &ServiceNames) -> Result<Self, ShmError> {
-        let service_name = names.full(T::KIND);
-        let service = services::stream::<T>(node, names)?;
-        let event = services::stream_event::<T>(node, names)?;
-        let subscriber = service
-            .subscriber_builder()
-            .buffer_size(services::STREAM_PEER_BUFFER)
-            .create()
-            .map_err(|e| ShmError::ipc("create subscriber on", &service_name, e))?;
-        let listener = event
+        let service = services::publish_subscribe::<T>(node, names, Access::OpenOrCreate)?;
+        let receiver = TopicReceiver::subscribe(names, &service, services::STREAM_PEER_BUFFER)?;
+        let listener = services::stream_event::<T>(node, names)?
             .listener_builder()
             .create()
-            .map_err(|e| ShmError::ipc("create listener on", &service_name, e))?;
+            .map_err(|e| ShmError::ipc("create listener on", receiver.name(), e))?;
         Ok(Self {
-            service_name,
-            subscriber,
+            receiver,
             listener,
             service,
-            _event: event,
         })
     }
 
@@ -102,22 +75,13 @@ impl<T: StreamPayload> StreamReceiver<T> {
         match self.listener.timed_wait(|_| {}, timeout) {
             Ok(count) => Ok(count > 0),
             Err(ListenerWaitError::InterruptSignal) => Ok(false),
-            Err(e) => Err(ShmError::ipc("wait for", &self.service_name, e)),
+            Err(e) => Err(ShmError::ipc("wait for", self.receiver.name(), e)),
         }
     }
 
     /// Copies the newest received message into `out`, dropping older ones; returns false when
     /// nothing new arrived. No heap allocation.
     pub(crate) fn take_latest(&self, out: &mut T) -> Result<bool, ShmError> {
-        let mut fresh = false;
-        while let Some(sample) = self
-            .subscriber
-            .receive()
-            .map_err(|e| ShmError::ipc("receive from", &self.service_name, e))?
-        {
-            *out = *sample.payload();
-            fresh = true;
-        }
-        Ok(fresh)
+        self.receiver.take_latest(out)
     }
 }

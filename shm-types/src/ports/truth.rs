@@ -1,18 +1,13 @@
 //! The simulator's ground truth (`sim-truth`): a simulator publishes its true state, evaluation
 //! clients subscribe. A hardware adapter has no such service.
 
-use iceoryx2::port::publisher::Publisher;
-use iceoryx2::port::subscriber::Subscriber;
-use iceoryx2::prelude::*;
-
-use crate::services::{self, IpcNode, PubSub, SIM_TRUTH};
+use super::topic::{TopicReceiver, TopicSender};
+use crate::services::{self, IpcNode};
 use crate::{ServiceNames, ShmError, SimTruth};
 
 /// The simulator's end: publishes its true state. Allocation-free after `open`.
 pub struct TruthPublisher {
-    service_name: String,
-    publisher: Publisher<ipc::Service, SimTruth, ()>,
-    _service: PubSub<SimTruth>,
+    sender: TopicSender<SimTruth>,
     _node: IpcNode,
 }
 
@@ -20,26 +15,15 @@ impl TruthPublisher {
     /// Opens (or creates) `sim-truth` under `names`.
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, _) = services::create_node(node_name)?;
-        let service_name = names.full(SIM_TRUTH);
-        let service = services::sim_truth(&node, names)?;
-        let publisher = service
-            .publisher_builder()
-            .create()
-            .map_err(|e| ShmError::ipc("create publisher on", &service_name, e))?;
         Ok(Self {
-            service_name,
-            publisher,
-            _service: service,
+            sender: TopicSender::open(&node, names, 2)?,
             _node: node,
         })
     }
 
     /// Publishes one state.
     pub fn publish(&self, truth: &SimTruth) -> Result<(), ShmError> {
-        self.publisher
-            .send_copy(*truth)
-            .map(|_| ())
-            .map_err(|e| ShmError::ipc("send on", &self.service_name, e))
+        self.sender.send_copy(truth)
     }
 }
 
@@ -47,9 +31,7 @@ impl TruthPublisher {
 /// [`services::SIM_TRUTH_BUFFER`] unread states (then the oldest are dropped, visible as gaps in
 /// [`SimTruth::seq`]), so drain it often.
 pub struct TruthSubscriber {
-    service_name: String,
-    subscriber: Subscriber<ipc::Service, SimTruth, ()>,
-    _service: PubSub<SimTruth>,
+    receiver: TopicReceiver<SimTruth>,
     _node: IpcNode,
 }
 
@@ -58,32 +40,15 @@ impl TruthSubscriber {
     /// newest one before) are received.
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, _) = services::create_node(node_name)?;
-        let service_name = names.full(SIM_TRUTH);
-        let service = services::sim_truth(&node, names)?;
-        let subscriber = service
-            .subscriber_builder()
-            .create()
-            .map_err(|e| ShmError::ipc("create subscriber on", &service_name, e))?;
         Ok(Self {
-            service_name,
-            subscriber,
-            _service: service,
+            receiver: TopicReceiver::open(&node, names, services::SIM_TRUTH_BUFFER)?,
             _node: node,
         })
     }
 
     /// Passes every state received since the last call to `each`, oldest first; returns how many.
-    pub fn drain(&self, mut each: impl FnMut(&SimTruth)) -> Result<usize, ShmError> {
-        let mut count = 0;
-        while let Some(sample) = self
-            .subscriber
-            .receive()
-            .map_err(|e| ShmError::ipc("receive from", &self.service_name, e))?
-        {
-            each(sample.payload());
-            count += 1;
-        }
-        Ok(count)
+    pub fn drain(&self, each: impl FnMut(&SimTruth)) -> Result<usize, ShmError> {
+        self.receiver.drain(each)
     }
 }
 
