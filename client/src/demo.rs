@@ -19,8 +19,7 @@ use stance::{Gait, WalkRequest};
 use crate::daemon_client::connect_when_fresh;
 use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
 use crate::evaluate::truth::judged_outcome;
-use crate::evaluate::watch::{WatchOptions, watch_walk};
-use crate::observe::RecorderOutcome;
+use crate::evaluate::watch::{WatchOptions, WatchedWalk, watch_walk};
 use crate::process::{Launch, Processes, executable_dir};
 use crate::watch::StanceProgress;
 
@@ -91,74 +90,90 @@ pub struct DemoArgs {
     pub plots: Option<PathBuf>,
 }
 
-/// What the demo measured.
-#[derive(Debug, Clone)]
+/// What the demo measured: the watched walk, its gait and the plot.
 pub struct DemoOutcome {
-    /// The final daemon status.
-    pub status: DaemonStatus,
-    /// Forward distance the feet midpoint covered (m).
-    pub distance_m: f64,
-    /// Stances completed.
-    pub stances: u32,
-    /// Simulated (control-tick) time from submission to the end (s).
-    pub sim_s: f64,
-    /// Wall time from submission to the end (s).
-    pub wall_s: f64,
-    /// Simulated time from submission at which the simulator's fall rule first fired (s).
-    pub fell_at_s: Option<f64>,
-    /// Largest tilt of the simulated `base_link` since submission (rad); `None` when no
-    /// simulator published its truth (e.g. a running walkd driving a real robot).
-    pub max_tilt_rad: Option<f64>,
-    /// The gait walked.
-    pub gait: Gait,
-    /// Walking speed: the simulated soles' travel over the simulated time from the first step
-    /// (a sole rising 1 cm) to the end (m/s); `None` without simulator truth or a step.
-    pub speed_m_s: Option<f64>,
-    /// The recording, with `--record`.
-    pub recording: Option<RecorderOutcome>,
-    /// The Fig. 6 plot, with `--plots`.
-    pub plot: Option<PathBuf>,
+    walk: WatchedWalk,
+    gait: Gait,
+    plot: Option<PathBuf>,
 }
 
 impl DemoOutcome {
+    /// The daemon's status after the walk, with its complete tick statistics.
+    pub fn status(&self) -> &DaemonStatus {
+        &self.walk.settled
+    }
+
+    /// Forward distance the feet midpoint covered, by the controller's estimate (m).
+    pub fn distance_m(&self) -> f64 {
+        feet_midpoint(self.status())[0] - feet_midpoint(&self.walk.start)[0]
+    }
+
+    /// Stances completed.
+    pub fn stances(&self) -> u32 {
+        let status = self.status();
+        if status.state == DaemonState::Done {
+            status.stance_count
+        } else {
+            status.stance_index
+        }
+    }
+
+    /// Simulated time from submission at which the simulator's fall rule first fired (s).
+    pub fn fell_at_s(&self) -> Option<f64> {
+        self.walk.verdict.and_then(|v| v.fell_at_s)
+    }
+
+    /// Largest tilt of the simulated `base_link` since submission (rad); `None` when no
+    /// simulator published its truth (e.g. a running walkd driving a real robot).
+    pub fn max_tilt_rad(&self) -> Option<f64> {
+        self.walk.verdict.map(|v| v.max_tilt_rad)
+    }
+
+    /// Walking speed: the simulated soles' travel over the simulated time from the first step
+    /// (a sole rising 1 cm) to the end (m/s); `None` without simulator truth or a step.
+    pub fn speed_m_s(&self) -> Option<f64> {
+        self.walk.verdict.and_then(|v| v.speed_m_s(self.walk.sim_s))
+    }
+
     /// `done`, the fault / state the walk ended in, or `fell at <t> s (daemon: ...)`.
     pub fn outcome(&self) -> String {
-        let state = self.status.state;
-        let daemon = if state == DaemonState::Done {
+        let status = self.status();
+        let daemon = if status.state == DaemonState::Done {
             "done".to_owned()
         } else {
-            format!("{}: {}", state.name(), self.status.fault)
+            format!("{}: {}", status.state.name(), status.fault)
         };
-        judged_outcome(self.fell_at_s, &daemon)
+        judged_outcome(self.fell_at_s(), &daemon)
     }
 
     /// The walk completed and the simulated robot (if any) never fell.
     pub fn succeeded(&self) -> bool {
-        self.status.state == DaemonState::Done && self.fell_at_s.is_none()
+        self.status().state == DaemonState::Done && self.fell_at_s().is_none()
     }
 
     fn json(&self) -> serde_json::Value {
         let tick =
             |s: &LatencySummary| serde_json::json!({"p50": s.p50, "p99": s.p99, "max": s.max});
+        let (status, walk) = (self.status(), &self.walk);
         serde_json::json!({
             "outcome": self.outcome(),
-            "distance_m": self.distance_m,
+            "distance_m": self.distance_m(),
             "gait": self.gait.name(),
-            "speed_m_s": self.speed_m_s,
-            "stances": self.stances,
-            "sim_s": self.sim_s,
-            "wall_s": self.wall_s,
-            "real_time_factor": self.sim_s / self.wall_s,
-            "fell_at_s": self.fell_at_s,
-            "max_tilt_rad": self.max_tilt_rad,
-            "deadline_misses": self.status.deadline_misses,
-            "stale_periods": self.status.stale_periods,
-            "tick_us": tick(&self.status.tick_us),
-            "latency_us": tick(&self.status.latency_us),
-            "clock": self.status.clock.name(),
-            "rate_hz": self.status.rate_hz,
+            "speed_m_s": self.speed_m_s(),
+            "stances": self.stances(),
+            "sim_s": walk.sim_s,
+            "wall_s": walk.wall_s,
+            "real_time_factor": walk.sim_s / walk.wall_s,
+            "fell_at_s": self.fell_at_s(),
+            "max_tilt_rad": self.max_tilt_rad(),
+            "deadline_misses": status.deadline_misses,
+            "stale_periods": status.stale_periods,
+            "tick_us": tick(&status.tick_us),
+            "latency_us": tick(&status.latency_us),
+            "clock": status.clock.name(),
+            "rate_hz": status.rate_hz,
             "plot": self.plot,
-            "recording": self.recording.as_ref().map(|r| serde_json::json!({
+            "recording": walk.recording.as_ref().map(|r| serde_json::json!({
                 "file": r.summary.path,
                 "messages": r.summary.messages,
                 "bytes": r.summary.bytes,
@@ -274,27 +289,7 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     if !problems.is_empty() {
         bail!("shutting down: {}", problems.join("; "));
     }
-    let status = walk.settled;
-    let stances = if status.state == DaemonState::Done {
-        status.stance_count
-    } else {
-        status.stance_index
-    };
-    let verdict = walk.verdict;
-    let sim_s = walk.sim_s;
-    Ok(DemoOutcome {
-        distance_m: feet_midpoint(&status)[0] - feet_midpoint(&walk.start)[0],
-        stances,
-        sim_s,
-        wall_s: walk.wall_s,
-        gait,
-        speed_m_s: verdict.and_then(|v| v.speed_m_s(sim_s)),
-        fell_at_s: verdict.and_then(|v| v.fell_at_s),
-        max_tilt_rad: verdict.map(|v| v.max_tilt_rad),
-        recording: walk.recording,
-        plot,
-        status,
-    })
+    Ok(DemoOutcome { walk, gait, plot })
 }
 
 /// `walkctl demo`: runs the demo and prints the outcome; fails unless the walk is done.
@@ -303,28 +298,29 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     if args.json {
         println!("{}", outcome.json());
     } else {
-        let tilt = outcome.max_tilt_rad.map_or_else(
+        let tilt = outcome.max_tilt_rad().map_or_else(
             || "no simulator truth".to_owned(),
             |tilt| format!("{tilt:.3} rad"),
         );
+        let walk = &outcome.walk;
         println!(
             "outcome: {}\ndistance covered: {:.3} m ({} gait, {})\nstances executed: {}\n\
              simulated {:.2} s in {:.2} s wall (real-time factor {:.1})\n\
              largest base tilt in the simulator: {tilt}\n{}",
             outcome.outcome(),
-            outcome.distance_m,
+            outcome.distance_m(),
             outcome.gait.name(),
-            outcome.speed_m_s.map_or_else(
+            outcome.speed_m_s().map_or_else(
                 || "no step seen".to_owned(),
                 |v| format!("{v:.3} m/s from the first step")
             ),
-            outcome.stances,
-            outcome.sim_s,
-            outcome.wall_s,
-            outcome.sim_s / outcome.wall_s,
-            status_text(&outcome.status)
+            outcome.stances(),
+            walk.sim_s,
+            walk.wall_s,
+            walk.sim_s / walk.wall_s,
+            status_text(outcome.status())
         );
-        if let Some(recording) = &outcome.recording {
+        if let Some(recording) = &walk.recording {
             println!(
                 "recording: {} ({} messages, {:.1} MB; the observer lost {} telemetries, {} \
                  samples, {} commands)\n  open it in Foxglove (Open local file; docs/observe.md \
