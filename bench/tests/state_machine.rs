@@ -106,14 +106,7 @@ fn force_spikes_while_swinging_or_above_the_ground_are_not_touchdowns() {
         assert!(!h.closed.controller.status().contacts[EndEffector::RightFoot as usize]);
     }
     // The real touchdown is confirmed and the walk finishes.
-    for _ in 0..MAX_TICKS {
-        h.tick();
-        h.assert_safe();
-        if h.closed.controller.status().state != ControllerState::Executing {
-            break;
-        }
-    }
-    assert_eq!(h.closed.controller.status().state, ControllerState::Done);
+    walk_to_done(&mut h, |_| {});
 }
 
 #[test]
@@ -153,19 +146,7 @@ fn abort_in_every_phase_holds_safely_and_a_new_sequence_can_start() {
         // From Holding, a new sequence (from wherever the robot stands) runs to the end.
         let sequence = walk_support::synthetic_walk(&h.robot, 2, 0.05, false);
         h.start(&sequence);
-        for _ in 0..MAX_TICKS {
-            h.tick();
-            h.assert_safe();
-            if h.closed.controller.status().state != ControllerState::Executing {
-                break;
-            }
-        }
-        assert_eq!(
-            h.closed.controller.status().state,
-            ControllerState::Done,
-            "{phase:?}: {:?}",
-            h.closed.controller.status()
-        );
+        walk_to_done(&mut h, |_| {});
     }
 }
 
@@ -218,14 +199,7 @@ fn start_is_refused_while_executing_and_in_fault_until_reset() {
     assert_eq!(why, StartRefusal::NoMeasurement);
     h.tick();
     assert!(h.closed.controller.start(refused).is_ok());
-    for _ in 0..MAX_TICKS {
-        h.tick();
-        h.assert_safe();
-        if h.closed.controller.status().state != ControllerState::Executing {
-            break;
-        }
-    }
-    assert_eq!(h.closed.controller.status().state, ControllerState::Done);
+    walk_to_done(&mut h, |_| {});
 }
 
 #[test]

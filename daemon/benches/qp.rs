@@ -12,7 +12,8 @@ mod qp_common;
 use std::hint::black_box;
 use std::time::Duration;
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::measurement::WallTime;
+use criterion::{BenchmarkGroup, Criterion, criterion_group, criterion_main};
 use daemon::qp::{ClarabelSolver, DenseActiveSetSolver, QpProblem, QpSolver, problems_from_json};
 use nalgebra::DVector;
 use qp_common::{Activity, Conditioning, Shape, controller_like};
@@ -31,51 +32,31 @@ struct Case {
 const CASES: [Case; 5] = [
     Case {
         name: "n36_none_active",
-        shape: Shape {
-            n: 36,
-            m_eq: 12,
-            m_ineq: 8,
-        },
+        shape: Shape::new(36, 12, 8),
         conditioning: Conditioning::Well,
         activity: Activity::None,
     },
     Case {
         name: "n36_some_active",
-        shape: Shape {
-            n: 36,
-            m_eq: 12,
-            m_ineq: 12,
-        },
+        shape: Shape::new(36, 12, 12),
         conditioning: Conditioning::Well,
         activity: Activity::Some,
     },
     Case {
         name: "n40_some_active",
-        shape: Shape {
-            n: 40,
-            m_eq: 12,
-            m_ineq: 16,
-        },
+        shape: Shape::new(40, 12, 16),
         conditioning: Conditioning::Well,
         activity: Activity::Some,
     },
     Case {
         name: "ill_n36_none_active",
-        shape: Shape {
-            n: 36,
-            m_eq: 12,
-            m_ineq: 8,
-        },
+        shape: Shape::new(36, 12, 8),
         conditioning: Conditioning::Ill,
         activity: Activity::None,
     },
     Case {
         name: "ill_n40_some_active",
-        shape: Shape {
-            n: 40,
-            m_eq: 12,
-            m_ineq: 16,
-        },
+        shape: Shape::new(40, 12, 16),
         conditioning: Conditioning::Ill,
         activity: Activity::Some,
     },
@@ -134,6 +115,22 @@ fn recorded(name: &str) -> Vec<QpProblem> {
         .unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
+/// Benchmarks `solve` as `name` of `group`, on `problems` in turn, one problem per iteration.
+fn bench_cycling<R>(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    problems: &[QpProblem],
+    mut solve: impl FnMut(&QpProblem) -> R,
+) {
+    let mut i = 0;
+    group.bench_function(name, |b| {
+        b.iter(|| {
+            i += 1;
+            black_box(solve(&problems[i % problems.len()]))
+        })
+    });
+}
+
 /// Dense (cold) and clarabel on recorded controller QPs.
 fn bench_recorded(c: &mut Criterion) {
     for name in ["jvrc1", "armar4"] {
@@ -144,20 +141,13 @@ fn bench_recorded(c: &mut Criterion) {
         let mut group = c.benchmark_group(format!("recorded_{name}"));
         let mut x = vec![0.0; n];
         let mut dense = DenseActiveSetSolver::new(n, max_eq, max_ineq);
-        let mut i = 0;
-        group.bench_function("dense_cold", |b| {
-            b.iter(|| {
-                dense.reset_warm_start();
-                i += 1;
-                black_box(dense.solve(&problems[i % problems.len()], &mut x)).unwrap()
-            })
+        bench_cycling(&mut group, "dense_cold", &problems, |p| {
+            dense.reset_warm_start();
+            dense.solve(p, &mut x).unwrap()
         });
         let mut clarabel = ClarabelSolver::new();
-        group.bench_function("clarabel", |b| {
-            b.iter(|| {
-                i += 1;
-                black_box(clarabel.solve(&problems[i % problems.len()], &mut x)).unwrap()
-            })
+        bench_cycling(&mut group, "clarabel", &problems, |p| {
+            clarabel.solve(p, &mut x).unwrap()
         });
         group.finish();
     }
@@ -176,28 +166,16 @@ fn bench(c: &mut Criterion) {
         let (n, m_eq, m_ineq) = (case.shape.n, case.shape.m_eq, case.shape.m_ineq);
         let mut x = vec![0.0; n];
         let mut dense = DenseActiveSetSolver::new(n, m_eq, m_ineq);
-        let mut i = 0;
-        group.bench_function("dense_cold", |b| {
-            b.iter(|| {
-                dense.reset_warm_start();
-                i += 1;
-                black_box(dense.solve(&independent[i % PROBLEMS], &mut x)).unwrap()
-            })
+        bench_cycling(&mut group, "dense_cold", &independent, |p| {
+            dense.reset_warm_start();
+            dense.solve(p, &mut x).unwrap()
         });
-        let mut i = 0;
-        group.bench_function("dense_warm", |b| {
-            b.iter(|| {
-                i += 1;
-                black_box(dense.solve(&sequence[i % PROBLEMS], &mut x)).unwrap()
-            })
+        bench_cycling(&mut group, "dense_warm", &sequence, |p| {
+            dense.solve(p, &mut x).unwrap()
         });
         let mut clarabel = ClarabelSolver::new();
-        let mut i = 0;
-        group.bench_function("clarabel", |b| {
-            b.iter(|| {
-                i += 1;
-                black_box(clarabel.solve(&independent[i % PROBLEMS], &mut x)).unwrap()
-            })
+        bench_cycling(&mut group, "clarabel", &independent, |p| {
+            clarabel.solve(p, &mut x).unwrap()
         });
         group.finish();
     }

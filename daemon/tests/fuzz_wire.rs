@@ -72,107 +72,77 @@ fn zeros<T>() -> Vec<u8> {
     vec![0; size_of::<T>()]
 }
 
+/// [`fuzz`] of [`CASES`] messages of type `T` around the all-zero message.
+fn fuzz_message<T: Copy>(name: &str, check: impl FnMut(&T)) {
+    fuzz(name, CASES, zeros::<T>(), check);
+}
+
 #[test]
 fn sensor_samples() {
-    fuzz(
-        "SensorSample",
-        CASES,
-        zeros::<SensorSample>(),
-        |sample: &SensorSample| {
-            assert_eq!(sample.imu().is_ok(), sample.has_imu.raw() <= 1);
-            assert_eq!(sample.holding().is_ok(), sample.adapter_holding.raw() <= 1);
-            assert!(sample.q().len() <= shm_types::MAX_JOINTS);
-            let _ = sample.qd();
-        },
-    );
+    fuzz_message("SensorSample", |sample: &SensorSample| {
+        assert_eq!(sample.imu().is_ok(), sample.has_imu.raw() <= 1);
+        assert_eq!(sample.holding().is_ok(), sample.adapter_holding.raw() <= 1);
+        assert!(sample.q().len() <= shm_types::MAX_JOINTS);
+        let _ = sample.qd();
+    });
 }
 
 #[test]
 fn joint_commands() {
-    fuzz(
-        "JointCommand",
-        CASES,
-        zeros::<JointCommand>(),
-        |command: &JointCommand| {
-            assert_eq!(command.mode.get().is_ok(), command.mode.raw() <= 1);
-            let _ = (command.q_des(), command.qd_des());
-        },
-    );
+    fuzz_message("JointCommand", |command: &JointCommand| {
+        assert_eq!(command.mode.get().is_ok(), command.mode.raw() <= 1);
+        let _ = (command.q_des(), command.qd_des());
+    });
 }
 
 #[test]
 fn daemon_statuses() {
-    fuzz(
-        "DaemonStatus",
-        CASES,
-        zeros::<DaemonStatus>(),
-        |status: &DaemonStatus| {
-            let defined = status.state.raw() <= 5
-                && status.clock.raw() <= 1
-                && status.link.raw() <= 2
-                && status.adapter_holding.raw() <= 1;
-            assert_eq!(status.validate().is_ok(), defined);
-            let _ = (
-                status.phase.as_str(),
-                status.fault.as_str(),
-                status.last_rejection.as_str(),
-                status.state.name(),
-            );
-        },
-    );
+    fuzz_message("DaemonStatus", |status: &DaemonStatus| {
+        let defined = status.state.raw() <= 5
+            && status.clock.raw() <= 1
+            && status.link.raw() <= 2
+            && status.adapter_holding.raw() <= 1;
+        assert_eq!(status.validate().is_ok(), defined);
+        let _ = (
+            status.phase.as_str(),
+            status.fault.as_str(),
+            status.last_rejection.as_str(),
+            status.state.name(),
+        );
+    });
 }
 
 #[test]
 fn control_requests_and_replies() {
-    fuzz(
-        "ControlRequest",
-        CASES,
-        zeros::<ControlRequest>(),
-        |request: &ControlRequest| {
-            let error = request.command.get().err();
-            assert_eq!(error.is_none(), request.command.raw() <= 2);
-            if let Some(error) = error {
-                assert!(
-                    error
-                        .to_string()
-                        .contains(&request.command.raw().to_string())
-                );
-            }
-        },
-    );
-    fuzz(
-        "ControlReply",
-        CASES,
-        zeros::<ControlReply>(),
-        |reply: &ControlReply| {
-            let _ = (
-                reply.accepted.get(),
-                reply.message.as_str(),
-                reply.status.validate(),
+    fuzz_message("ControlRequest", |request: &ControlRequest| {
+        let error = request.command.get().err();
+        assert_eq!(error.is_none(), request.command.raw() <= 2);
+        if let Some(error) = error {
+            assert!(
+                error
+                    .to_string()
+                    .contains(&request.command.raw().to_string())
             );
-        },
-    );
+        }
+    });
+    fuzz_message("ControlReply", |reply: &ControlReply| {
+        let _ = (
+            reply.accepted.get(),
+            reply.message.as_str(),
+            reply.status.validate(),
+        );
+    });
 }
 
 #[test]
 fn submit_replies_and_sim_truth() {
-    fuzz(
-        "SubmitReply",
-        CASES,
-        zeros::<SubmitReply>(),
-        |reply: &SubmitReply| {
-            assert_eq!(reply.accepted.get().is_ok(), reply.accepted.raw() <= 1);
-            let _ = reply.reason.as_str();
-        },
-    );
-    fuzz(
-        "SimTruth",
-        CASES,
-        zeros::<SimTruth>(),
-        |truth: &SimTruth| {
-            let _ = truth.fallen.get();
-        },
-    );
+    fuzz_message("SubmitReply", |reply: &SubmitReply| {
+        assert_eq!(reply.accepted.get().is_ok(), reply.accepted.raw() <= 1);
+        let _ = reply.reason.as_str();
+    });
+    fuzz_message("SimTruth", |truth: &SimTruth| {
+        let _ = truth.fallen.get();
+    });
 }
 
 /// A JVRC-1 standing still, as the bytes of a sensor sample.

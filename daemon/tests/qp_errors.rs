@@ -3,16 +3,12 @@
 
 mod qp_common;
 
-use daemon::qp::{ClarabelSolver, DenseActiveSetSolver, QpError, QpProblem, QpSolver};
+use daemon::qp::{ClarabelSolver, DenseActiveSetSolver, QpError, QpPartsMut, QpProblem, QpSolver};
 use qp_common::{Activity, Conditioning, Shape, controller_like};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-const SHAPE: Shape = Shape {
-    n: 36,
-    m_eq: 12,
-    m_ineq: 10,
-};
+const SHAPE: Shape = Shape::new(36, 12, 10);
 const SENTINEL: f64 = 12345.0;
 
 fn base_problem(seed: u64) -> QpProblem {
@@ -37,8 +33,11 @@ fn both_fail(problem: &QpProblem) -> (QpError, QpError) {
     (dense_err, clarabel_err)
 }
 
-fn assert_infeasible(problem: &QpProblem, case: &str) {
-    let (dense, clarabel) = both_fail(problem);
+/// `base_problem(seed)` with `edit` applied: both solvers must refuse it as infeasible.
+fn assert_infeasible_after(seed: u64, case: &str, edit: impl FnOnce(&mut QpPartsMut<'_>)) {
+    let mut problem = base_problem(seed);
+    edit(&mut problem.parts_mut());
+    let (dense, clarabel) = both_fail(&problem);
     assert_eq!(dense, QpError::Infeasible, "{case}: dense");
     assert_eq!(clarabel, QpError::Infeasible, "{case}: clarabel");
 }
@@ -57,61 +56,54 @@ fn the_base_problem_is_feasible() {
 
 #[test]
 fn general_row_conflicting_with_a_bound_is_infeasible() {
-    let mut problem = base_problem(2);
-    let mut parts = problem.parts_mut();
-    parts.c.row_mut(3).fill(0.0);
-    parts.c[(3, 20)] = 2.0;
-    parts.x_max[20] = 0.1;
-    parts.l[3] = 0.5; // 2 x_20 ≥ 0.5 but x_20 ≤ 0.1
-    parts.u[3] = f64::INFINITY;
-    assert_infeasible(&problem, "row vs bound");
+    assert_infeasible_after(2, "row vs bound", |parts| {
+        parts.c.row_mut(3).fill(0.0);
+        parts.c[(3, 20)] = 2.0;
+        parts.x_max[20] = 0.1;
+        parts.l[3] = 0.5; // 2 x_20 ≥ 0.5 but x_20 ≤ 0.1
+        parts.u[3] = f64::INFINITY;
+    });
 }
 
 #[test]
 fn inconsistent_equalities_are_infeasible() {
-    let mut problem = base_problem(3);
-    let mut parts = problem.parts_mut();
-    let row = parts.a_eq.row(0).into_owned();
-    parts.a_eq.row_mut(5).copy_from(&row);
-    parts.b_eq[5] = parts.b_eq[0] + 1.0;
-    assert_infeasible(
-        &problem,
-        "duplicate equality rows with different right-hand sides",
-    );
+    let case = "duplicate equality rows with different right-hand sides";
+    assert_infeasible_after(3, case, |parts| {
+        let row = parts.a_eq.row(0).into_owned();
+        parts.a_eq.row_mut(5).copy_from(&row);
+        parts.b_eq[5] = parts.b_eq[0] + 1.0;
+    });
 }
 
 #[test]
 fn equality_outside_the_box_is_infeasible() {
-    let mut problem = base_problem(4);
-    let mut parts = problem.parts_mut();
-    parts.a_eq.row_mut(2).fill(0.0);
-    parts.a_eq[(2, 10)] = 1.0;
-    parts.x_min[10] = -0.3;
-    parts.x_max[10] = 0.3;
-    parts.b_eq[2] = 0.5;
-    assert_infeasible(&problem, "equality beyond the box");
+    assert_infeasible_after(4, "equality beyond the box", |parts| {
+        parts.a_eq.row_mut(2).fill(0.0);
+        parts.a_eq[(2, 10)] = 1.0;
+        parts.x_min[10] = -0.3;
+        parts.x_max[10] = 0.3;
+        parts.b_eq[2] = 0.5;
+    });
 }
 
 #[test]
 fn opposite_general_rows_are_infeasible() {
-    let mut problem = base_problem(5);
-    let mut parts = problem.parts_mut();
-    let row = parts.c.row(0).into_owned();
-    parts.c.row_mut(1).copy_from(&(-row));
-    parts.l[0] = 1.0; // c x ≥ 1
-    parts.u[0] = f64::INFINITY;
-    parts.l[1] = 0.0; // −c x ≥ 0, i.e. c x ≤ 0
-    parts.u[1] = f64::INFINITY;
-    assert_infeasible(&problem, "c x ≥ 1 and c x ≤ 0");
+    assert_infeasible_after(5, "c x ≥ 1 and c x ≤ 0", |parts| {
+        let row = parts.c.row(0).into_owned();
+        parts.c.row_mut(1).copy_from(&(-row));
+        parts.l[0] = 1.0; // c x ≥ 1
+        parts.u[0] = f64::INFINITY;
+        parts.l[1] = 0.0; // −c x ≥ 0, i.e. c x ≤ 0
+        parts.u[1] = f64::INFINITY;
+    });
 }
 
 #[test]
 fn crossed_bounds_are_infeasible() {
-    let mut problem = base_problem(6);
-    let mut parts = problem.parts_mut();
-    parts.x_min[7] = 0.2;
-    parts.x_max[7] = 0.1;
-    assert_infeasible(&problem, "x_min > x_max");
+    assert_infeasible_after(6, "x_min > x_max", |parts| {
+        parts.x_min[7] = 0.2;
+        parts.x_max[7] = 0.1;
+    });
 }
 
 #[test]

@@ -14,11 +14,7 @@ use serde_json::json;
 #[test]
 fn export_then_load_gives_the_same_problem_and_solution() {
     let mut rng = ChaCha8Rng::seed_from_u64(21);
-    let shape = Shape {
-        n: 36,
-        m_eq: 12,
-        m_ineq: 12,
-    };
+    let shape = Shape::new(36, 12, 12);
     let mut problem = controller_like(&mut rng, shape, Conditioning::Well, Activity::Some);
     problem.set_active_rows(6, 9).unwrap();
     assert!(problem.x_min()[0].is_infinite() && problem.u().iter().any(|v| v.is_infinite()));
@@ -48,11 +44,7 @@ fn export_then_load_gives_the_same_problem_and_solution() {
 #[test]
 fn recordings_may_be_arrays_or_wrapped() {
     let mut rng = ChaCha8Rng::seed_from_u64(22);
-    let shape = Shape {
-        n: 10,
-        m_eq: 2,
-        m_ineq: 3,
-    };
+    let shape = Shape::new(10, 2, 3);
     let a = export_json(&controller_like(
         &mut rng,
         shape,
@@ -79,11 +71,7 @@ fn bad_recordings_name_the_field() {
     let mut rng = ChaCha8Rng::seed_from_u64(23);
     let good = export_json(&controller_like(
         &mut rng,
-        Shape {
-            n: 8,
-            m_eq: 2,
-            m_ineq: 2,
-        },
+        Shape::new(8, 2, 2),
         Conditioning::Well,
         Activity::None,
     ));

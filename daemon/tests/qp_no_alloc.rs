@@ -66,11 +66,7 @@ fn the_counter_sees_allocations() {
 
 #[test]
 fn dense_solve_does_not_allocate() {
-    let shape = Shape {
-        n: 40,
-        m_eq: 12,
-        m_ineq: 16,
-    };
+    let shape = Shape::new(40, 12, 16);
     let mut rng = ChaCha8Rng::seed_from_u64(41);
     let mut problems: Vec<_> = (0..12)
         .map(|k| {
@@ -119,11 +115,7 @@ fn dense_solve_does_not_allocate() {
 #[test]
 fn dense_solve_does_not_allocate_for_larger_robots() {
     for n in [16, 64, 100, 128] {
-        let shape = Shape {
-            n,
-            m_eq: 12,
-            m_ineq: 8,
-        };
+        let shape = Shape::new(n, 12, 8);
         let mut rng = ChaCha8Rng::seed_from_u64(42 + n as u64);
         let problems: Vec<_> = (0..4)
             .map(|_| controller_like(&mut rng, shape, Conditioning::Well, Activity::Some))

@@ -4,11 +4,39 @@
 
 mod qp_common;
 
-use daemon::qp::{ClarabelSolver, DenseActiveSetSolver, QpSolver};
+use daemon::qp::{ClarabelSolver, DenseActiveSetSolver, QpInfo, QpProblem, QpSolver};
 use nalgebra::DVector;
-use qp_common::{Activity, Conditioning, Shape, controller_like, kkt, rel_dist};
+use qp_common::{
+    Activity, Conditioning, Shape, assert_certified, controller_like, kkt, rel_dist, rel_gap,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+
+/// Solves `problem` with both solvers (a failure panics naming `case`), asserts the dense
+/// objective is clarabel's to 1e-6 (relative), and returns the dense report, the dense solution
+/// and clarabel's.
+fn solve_both(
+    dense: &mut DenseActiveSetSolver,
+    clarabel: &mut ClarabelSolver,
+    problem: &QpProblem,
+    case: &str,
+) -> (QpInfo, DVector<f64>, DVector<f64>) {
+    let (mut x, mut x_ref) = (vec![0.0; problem.n()], vec![0.0; problem.n()]);
+    let info = dense
+        .solve(problem, &mut x)
+        .unwrap_or_else(|e| panic!("dense, {case}: {e}"));
+    let info_ref = clarabel
+        .solve(problem, &mut x_ref)
+        .unwrap_or_else(|e| panic!("clarabel, {case}: {e}"));
+    let obj_rel = rel_gap(info.objective, info_ref.objective);
+    assert!(
+        obj_rel <= 1e-6,
+        "{case}: objective {} vs clarabel {} (rel {obj_rel:e})",
+        info.objective,
+        info_ref.objective
+    );
+    (info, DVector::from_vec(x), DVector::from_vec(x_ref))
+}
 
 fn cross_check(seed: u64, shape: Shape, activity: Activity) -> (usize, usize) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -18,37 +46,14 @@ fn cross_check(seed: u64, shape: Shape, activity: Activity) -> (usize, usize) {
     let count = 15;
     for k in 0..count {
         let problem = controller_like(&mut rng, shape, Conditioning::Well, activity);
-        let mut x_dense = vec![0.0; shape.n];
-        let mut x_ref = vec![0.0; shape.n];
-        let info = dense
-            .solve(&problem, &mut x_dense)
-            .unwrap_or_else(|e| panic!("dense, problem {k}: {e}"));
-        let info_ref = clarabel
-            .solve(&problem, &mut x_ref)
-            .unwrap_or_else(|e| panic!("clarabel, problem {k}: {e}"));
-        let (x_dense, x_ref) = (DVector::from_vec(x_dense), DVector::from_vec(x_ref));
-        let obj_rel =
-            (info.objective - info_ref.objective).abs() / (1.0 + info_ref.objective.abs());
-        assert!(
-            obj_rel <= 1e-6,
-            "problem {k}: objective {} vs clarabel {} (rel {obj_rel:e})",
-            info.objective,
-            info_ref.objective
-        );
+        let (info, x_dense, x_ref) =
+            solve_both(&mut dense, &mut clarabel, &problem, &format!("problem {k}"));
         let dist = rel_dist(&x_dense, &x_ref);
         assert!(
             dist <= 1e-5,
             "problem {k}: x differs from clarabel by {dist:e}"
         );
-        let cert = kkt(&problem, &x_dense, 1e-9);
-        assert!(
-            cert.worst() <= 1e-9,
-            "problem {k}: dense KKT residuals {cert:?}"
-        );
-        assert_eq!(
-            info.active_constraints, cert.active,
-            "problem {k}: reported vs certified active count"
-        );
+        assert_certified(&problem, &x_dense, &info, &format!("problem {k}"));
         if activity == Activity::None {
             assert_eq!(
                 info.active_constraints, 0,
@@ -62,58 +67,31 @@ fn cross_check(seed: u64, shape: Shape, activity: Activity) -> (usize, usize) {
 
 #[test]
 fn n36_without_active_constraints_matches_clarabel() {
-    cross_check(
-        1,
-        Shape {
-            n: 36,
-            m_eq: 12,
-            m_ineq: 8,
-        },
-        Activity::None,
+    cross_check(1, Shape::new(36, 12, 8), Activity::None);
+}
+
+/// [`cross_check`] with active constraints: the generator must activate several per problem.
+fn cross_check_with_active_constraints(seed: u64, shape: Shape) {
+    let (active, count) = cross_check(seed, shape, Activity::Some);
+    assert!(
+        active >= 3 * count,
+        "the generator should activate several constraints per problem, got {active} over {count}"
     );
 }
 
 #[test]
 fn n36_with_active_constraints_matches_clarabel() {
-    let (active, count) = cross_check(
-        2,
-        Shape {
-            n: 36,
-            m_eq: 12,
-            m_ineq: 12,
-        },
-        Activity::Some,
-    );
-    assert!(
-        active >= 3 * count,
-        "the generator should activate several constraints per problem, got {active} over {count}"
-    );
+    cross_check_with_active_constraints(2, Shape::new(36, 12, 12));
 }
 
 #[test]
 fn n40_with_active_constraints_matches_clarabel() {
-    let (active, count) = cross_check(
-        3,
-        Shape {
-            n: 40,
-            m_eq: 12,
-            m_ineq: 16,
-        },
-        Activity::Some,
-    );
-    assert!(
-        active >= 3 * count,
-        "the generator should activate several constraints per problem, got {active} over {count}"
-    );
+    cross_check_with_active_constraints(3, Shape::new(40, 12, 16));
 }
 
 #[test]
 fn degenerate_constraints_match_clarabel() {
-    let shape = Shape {
-        n: 36,
-        m_eq: 12,
-        m_ineq: 12,
-    };
+    let shape = Shape::new(36, 12, 12);
     let mut rng = ChaCha8Rng::seed_from_u64(4);
     let mut dense = DenseActiveSetSolver::new(shape.n, shape.m_eq, shape.m_ineq);
     let mut clarabel = ClarabelSolver::high_precision();
@@ -139,22 +117,7 @@ fn degenerate_constraints_match_clarabel() {
             parts.a_eq.row_mut(11).copy_from(&a0);
             parts.b_eq[11] = parts.b_eq[0];
         }
-        let (mut x, mut x_ref) = (vec![0.0; shape.n], vec![0.0; shape.n]);
-        let info = dense
-            .solve(&problem, &mut x)
-            .unwrap_or_else(|e| panic!("dense, problem {k}: {e}"));
-        let info_ref = clarabel
-            .solve(&problem, &mut x_ref)
-            .unwrap_or_else(|e| panic!("clarabel, problem {k}: {e}"));
-        let obj_rel =
-            (info.objective - info_ref.objective).abs() / (1.0 + info_ref.objective.abs());
-        assert!(
-            obj_rel <= 1e-6,
-            "problem {k}: objective {} vs clarabel {}",
-            info.objective,
-            info_ref.objective
-        );
-        let x = DVector::from_vec(x);
+        let (_, x, _) = solve_both(&mut dense, &mut clarabel, &problem, &format!("problem {k}"));
         let cert = kkt(&problem, &x, 1e-9);
         assert!(
             cert.primal.max(cert.stationarity) <= 1e-9,
@@ -181,24 +144,10 @@ fn varied_shapes_match_clarabel() {
         };
         let problem = controller_like(&mut rng, shape, Conditioning::Well, activity);
         let mut dense = DenseActiveSetSolver::new(shape.n, shape.m_eq, shape.m_ineq);
-        let (mut x, mut x_ref) = (vec![0.0; n], vec![0.0; n]);
-        let info = dense
-            .solve(&problem, &mut x)
-            .unwrap_or_else(|e| panic!("dense, problem {k} {shape:?}: {e}"));
-        let info_ref = clarabel
-            .solve(&problem, &mut x_ref)
-            .unwrap_or_else(|e| panic!("clarabel, problem {k} {shape:?}: {e}"));
-        let obj_rel =
-            (info.objective - info_ref.objective).abs() / (1.0 + info_ref.objective.abs());
+        let case = format!("problem {k} {shape:?}");
+        let (_, x, x_ref) = solve_both(&mut dense, &mut clarabel, &problem, &case);
         assert!(
-            obj_rel <= 1e-6,
-            "problem {k} {shape:?}: objective {} vs {}",
-            info.objective,
-            info_ref.objective
-        );
-        let x = DVector::from_vec(x);
-        assert!(
-            rel_dist(&x, &DVector::from_vec(x_ref)) <= 1e-5,
+            rel_dist(&x, &x_ref) <= 1e-5,
             "problem {k} {shape:?}: x differs"
         );
         let cert = kkt(&problem, &x, 1e-9);

@@ -13,6 +13,15 @@ fn robot(name: &str) -> Arc<Robot> {
     Arc::new(Robot::load(&path, None).expect("vendored robot loads"))
 }
 
+/// A simulator of `robot` standing, the standing joint angles (a command to edit) and zero joint
+/// velocities.
+fn standing(robot: &Arc<Robot>) -> (KinematicSim, Vec<f64>, Vec<f64>) {
+    let sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
+    let q: Vec<f64> = robot.standing.joints.iter().copied().collect();
+    let zeros = vec![0.0; q.len()];
+    (sim, q, zeros)
+}
+
 fn leg_joint(robot: &Robot, prefix_left: bool, contains: &str) -> usize {
     let legs = &robot.joint_groups.legs;
     let half = legs.len() / 2;
@@ -83,9 +92,7 @@ fn standing_robot_is_supported_by_both_feet_with_its_weight() {
 #[test]
 fn holding_still_keeps_everything_fixed_and_deterministic() {
     let robot = robot("jvrc1");
-    let mut a = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
-    let q: Vec<f64> = robot.standing.joints.iter().copied().collect();
-    let zeros = vec![0.0; q.len()];
+    let (mut a, q, zeros) = standing(&robot);
     for _ in 0..100 {
         a.step(&q, &zeros, 0.002).unwrap();
     }
@@ -98,9 +105,7 @@ fn holding_still_keeps_everything_fixed_and_deterministic() {
 #[test]
 fn bending_one_knee_lifts_that_foot_and_releases_it() {
     let robot = robot("jvrc1");
-    let mut sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
-    let mut q: Vec<f64> = robot.standing.joints.iter().copied().collect();
-    let zeros = vec![0.0; q.len()];
+    let (mut sim, mut q, zeros) = standing(&robot);
     let hip = leg_joint(&robot, false, "hip_p");
     let knee = leg_joint(&robot, false, "knee");
     for _ in 0..50 {
@@ -135,9 +140,7 @@ fn bending_one_knee_lifts_that_foot_and_releases_it() {
 #[test]
 fn commands_beyond_limits_stop_there_and_are_counted_and_bad_commands_are_refused() {
     let robot = robot("jvrc1");
-    let mut sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
-    let mut q: Vec<f64> = robot.standing.joints.iter().copied().collect();
-    let zeros = vec![0.0; q.len()];
+    let (mut sim, mut q, zeros) = standing(&robot);
     let arm = robot.joint_groups.arms[0];
     q[arm] = robot.model.joint_limits()[arm].upper + 0.5;
     sim.step(&q, &zeros, 0.002).unwrap();
@@ -172,9 +175,7 @@ fn moving_every_joint_in_single_support_keeps_the_stance_foot_in_place() {
     // Regression: composing the base with inverse poses every step used to let the quaternion
     // norm error double per step until the base diverged.
     let robot = robot("jvrc1");
-    let mut sim = KinematicSim::new(robot.clone(), robot.standing.clone()).unwrap();
-    let mut q: Vec<f64> = robot.standing.joints.iter().copied().collect();
-    let zeros = vec![0.0; q.len()];
+    let (mut sim, mut q, zeros) = standing(&robot);
     let (hip, knee) = (
         leg_joint(&robot, false, "hip_p"),
         leg_joint(&robot, false, "knee"),

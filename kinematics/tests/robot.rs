@@ -54,15 +54,21 @@ fn assert_soles_flat(robot: &Robot) {
     assert!(kin.link_pose(robot.base_link).translation.z > 0.5);
 }
 
-#[test]
-fn armar4_loads_and_stands_flat() {
-    let robot = Robot::load(&config("armar4"), None).unwrap();
-    assert_eq!(robot.model.dof(), 30);
+/// `configs/<name>.toml` loaded; it must have `dof` joints and weigh `mass` kg (to 0.1 g).
+fn load_with(name: &str, dof: usize, mass: f64) -> Robot {
+    let robot = Robot::load(&config(name), None).unwrap();
+    assert_eq!(robot.model.dof(), dof);
     assert!(
-        (robot.model.total_mass() - 72.04).abs() < 1e-4,
+        (robot.model.total_mass() - mass).abs() < 1e-4,
         "mass {}",
         robot.model.total_mass()
     );
+    robot
+}
+
+#[test]
+fn armar4_loads_and_stands_flat() {
+    let robot = load_with("armar4", 30, 72.04);
     assert_eq!(robot.joint_groups.legs.len(), 12);
     assert_eq!(robot.joint_groups.arms.len(), 16);
     assert_eq!(robot.joint_groups.torso.len(), 2);
@@ -71,13 +77,7 @@ fn armar4_loads_and_stands_flat() {
 
 #[test]
 fn jvrc1_loads_and_stands_flat() {
-    let robot = Robot::load(&config("jvrc1"), None).unwrap();
-    assert_eq!(robot.model.dof(), 34);
-    assert!(
-        (robot.model.total_mass() - 62.40).abs() < 1e-4,
-        "mass {}",
-        robot.model.total_mass()
-    );
+    let robot = load_with("jvrc1", 34, 62.40);
     let knee = robot.model.joint_index("L_KNEE").unwrap();
     assert!(robot.standing.joints[knee] > 0.1, "knees are bent");
     assert_soles_flat(&robot);
@@ -113,60 +113,56 @@ fn load_error(path: &Path) -> String {
     Robot::load(path, None).unwrap_err().to_string()
 }
 
+/// The jvrc1 config with `from` replaced by `to` (written under `tag`) is refused with a message
+/// that contains each of `names`.
+fn assert_edit_refused(tag: &str, from: &str, to: &str, names: &[&str]) {
+    let message = load_error(&edited_jvrc1(|t| t.replace(from, to), tag));
+    assert!(names.iter().all(|name| message.contains(name)), "{message}");
+}
+
 #[test]
 fn unknown_link_names_key_and_link() {
-    let path = edited_jvrc1(
-        |t| t.replace("link = \"L_WRIST_Y_S\"", "link = \"NO_SUCH_LINK\""),
+    assert_edit_refused(
         "link",
-    );
-    let message = load_error(&path);
-    assert!(
-        message.contains("frames.left_hand.link") && message.contains("NO_SUCH_LINK"),
-        "{message}"
+        "link = \"L_WRIST_Y_S\"",
+        "link = \"NO_SUCH_LINK\"",
+        &["frames.left_hand.link", "NO_SUCH_LINK"],
     );
 }
 
 #[test]
 fn unknown_joint_names_key_and_joint() {
-    let path = edited_jvrc1(|t| t.replace("\"WAIST_Y\",", "\"WAIST_Q\","), "joint");
-    let message = load_error(&path);
-    assert!(
-        message.contains("joint_groups.torso") && message.contains("WAIST_Q"),
-        "{message}"
+    assert_edit_refused(
+        "joint",
+        "\"WAIST_Y\",",
+        "\"WAIST_Q\",",
+        &["joint_groups.torso", "WAIST_Q"],
     );
-    let path = edited_jvrc1(|t| t.replace("R_KNEE = 0.76", "R_KNEES = 0.76"), "standing");
-    let message = load_error(&path);
-    assert!(
-        message.contains("standing") && message.contains("R_KNEES"),
-        "{message}"
+    assert_edit_refused(
+        "standing",
+        "R_KNEE = 0.76",
+        "R_KNEES = 0.76",
+        &["standing", "R_KNEES"],
     );
 }
 
 #[test]
 fn unknown_key_is_refused() {
-    let path = edited_jvrc1(
-        |t| {
-            t.replace(
-                "base_link = \"PELVIS_S\"",
-                "base_link = \"PELVIS_S\"\nbase_lnk = 1",
-            )
-        },
+    assert_edit_refused(
         "key",
+        "base_link = \"PELVIS_S\"",
+        "base_link = \"PELVIS_S\"\nbase_lnk = 1",
+        &["base_lnk"],
     );
-    let message = load_error(&path);
-    assert!(message.contains("base_lnk"), "{message}");
 }
 
 #[test]
 fn posture_with_tilted_sole_is_refused() {
-    let path = edited_jvrc1(
-        |t| t.replace("R_ANKLE_P = -0.38", "R_ANKLE_P = -0.2"),
+    assert_edit_refused(
         "tilt",
-    );
-    let message = load_error(&path);
-    assert!(
-        message.contains("robot.standing") && message.contains("parallel"),
-        "{message}"
+        "R_ANKLE_P = -0.38",
+        "R_ANKLE_P = -0.2",
+        &["robot.standing", "parallel"],
     );
 }
 
@@ -322,7 +318,10 @@ fn a_missing_urdf_is_named_once() {
 
 #[test]
 fn an_unknown_section_is_refused() {
-    let path = edited_jvrc1(|t| t.replace("[runtime]", "[runtme]"), "section");
-    let message = load_error(&path);
-    assert!(message.contains("unknown section [runtme]"), "{message}");
+    assert_edit_refused(
+        "section",
+        "[runtime]",
+        "[runtme]",
+        &["unknown section [runtme]"],
+    );
 }

@@ -41,6 +41,14 @@ fn error_of(parts: &[String]) -> ModelError {
     Model::from_urdf_str(&robot(parts)).expect_err("the URDF must be refused")
 }
 
+/// The error refusing [`chain`] with `from` replaced by `to` in its part `index` (0–2: the links
+/// a, b, c; 3, 4: the joints j1, j2).
+fn error_with_edit(index: usize, from: &str, to: &str) -> ModelError {
+    let mut parts = chain();
+    parts[index] = parts[index].replace(from, to);
+    error_of(&parts)
+}
+
 #[test]
 fn valid_chain_loads() {
     let model = Model::from_urdf_str(&robot(&chain())).unwrap();
@@ -52,12 +60,11 @@ fn valid_chain_loads() {
 
 #[test]
 fn revolute_joint_without_limit() {
-    let mut parts = chain();
-    parts[4] = parts[4].replace(
+    let error = error_with_edit(
+        4,
         r#"<limit lower="-1" upper="1" effort="10" velocity="2"/>"#,
         "",
     );
-    let error = error_of(&parts);
     assert!(
         matches!(&error, ModelError::MissingLimit(joint, "revolute") if joint == "j2"),
         "{error}"
@@ -76,9 +83,7 @@ fn limit_in_a_comment_does_not_count() {
 
 #[test]
 fn inertia_not_positive_definite() {
-    let mut parts = chain();
-    parts[1] = parts[1].replace(r#"ixx="0.01""#, r#"ixx="0""#);
-    let error = error_of(&parts);
+    let error = error_with_edit(1, r#"ixx="0.01""#, r#"ixx="0""#);
     assert!(
         matches!(&error, ModelError::InvalidInertia { link, defect: InertiaDefect::NotPositiveDefinite { .. } } if link == "b"),
         "{error}"
@@ -87,9 +92,7 @@ fn inertia_not_positive_definite() {
 
 #[test]
 fn inertia_breaks_triangle_inequality() {
-    let mut parts = chain();
-    parts[2] = parts[2].replace(r#"izz="0.01""#, r#"izz="0.05""#);
-    let error = error_of(&parts);
+    let error = error_with_edit(2, r#"izz="0.01""#, r#"izz="0.05""#);
     assert!(
         matches!(&error, ModelError::InvalidInertia { link, defect: InertiaDefect::TriangleInequality { .. } } if link == "c"),
         "{error}"
@@ -183,9 +186,7 @@ fn nan_and_infinity_anywhere_numeric() {
             "xyz",
         ),
     ] {
-        let mut parts = chain();
-        parts[3] = parts[3].replace(from, to);
-        let error = error_of(&parts);
+        let error = error_with_edit(3, from, to);
         let ModelError::NonFinite {
             owner,
             element: e,
@@ -200,9 +201,7 @@ fn nan_and_infinity_anywhere_numeric() {
             ("joint 'j1'", element, attribute)
         );
     }
-    let mut parts = chain();
-    parts[0] = parts[0].replace(r#"<mass value="1"/>"#, r#"<mass value="NaN"/>"#);
-    let error = error_of(&parts);
+    let error = error_with_edit(0, r#"<mass value="1"/>"#, r#"<mass value="NaN"/>"#);
     assert!(
         matches!(&error, ModelError::NonFinite { owner, .. } if owner == "link 'a'"),
         "{error}"
@@ -211,18 +210,14 @@ fn nan_and_infinity_anywhere_numeric() {
 
 #[test]
 fn unsupported_joint_type() {
-    let mut parts = chain();
-    parts[4] = parts[4].replace(r#"type="revolute""#, r#"type="floating""#);
-    assert!(
-        matches!(error_of(&parts), ModelError::UnsupportedJoint { joint, .. } if joint == "j2")
-    );
+    let error = error_with_edit(4, r#"type="revolute""#, r#"type="floating""#);
+    assert!(matches!(error, ModelError::UnsupportedJoint { joint, .. } if joint == "j2"));
 }
 
 #[test]
 fn inverted_limits() {
-    let mut parts = chain();
-    parts[3] = parts[3].replace(r#"lower="-1" upper="1""#, r#"lower="1" upper="-1""#);
-    assert!(matches!(error_of(&parts), ModelError::InvalidLimits { joint, .. } if joint == "j1"));
+    let error = error_with_edit(3, r#"lower="-1" upper="1""#, r#"lower="1" upper="-1""#);
+    assert!(matches!(error, ModelError::InvalidLimits { joint, .. } if joint == "j1"));
 }
 
 #[test]
@@ -280,9 +275,7 @@ fn frames_are_validated() {
 
 #[test]
 fn an_actuated_joint_with_a_zero_velocity_limit_is_refused() {
-    let mut parts = chain();
-    parts[4] = parts[4].replace(r#"velocity="2""#, r#"velocity="0""#);
-    let error = error_of(&parts);
+    let error = error_with_edit(4, r#"velocity="2""#, r#"velocity="0""#);
     assert!(
         matches!(error, ModelError::ZeroVelocityLimit { ref joint, .. } if joint == "j2"),
         "{error}"

@@ -406,10 +406,11 @@ fn balance_on_left_foot(name: &str) {
             Some((shifted, lifted))
         })
         .unwrap_or_else(|| panic!("{name}: no posture puts the CoM over the left sole"));
-    let standing = robot.standing.joints.as_slice().to_vec();
+    let standing = robot.standing.joints.as_slice();
+    let (shifted_q, lifted_q) = (shifted.joints.as_slice(), lifted.joints.as_slice());
     let weight = robot.model.total_mass() * 9.81;
 
-    move_joints(&mut sim, &standing, shifted.joints.as_slice(), 1.5);
+    move_joints(&mut sim, standing, shifted_q, 1.5);
     // Both feet still touch, so how the load splits depends on the servos; the CoM must be over
     // the left sole and the left foot carry more.
     let m = sim.measurement();
@@ -428,12 +429,7 @@ fn balance_on_left_foot(name: &str) {
         "{name}: left foot not the loaded one"
     );
 
-    move_joints(
-        &mut sim,
-        shifted.joints.as_slice(),
-        lifted.joints.as_slice(),
-        1.0,
-    );
+    move_joints(&mut sim, shifted_q, lifted_q, 1.0);
     let m = sim.measurement();
     assert_eq!(
         m.contacts[..2],
@@ -465,16 +461,10 @@ fn balance_on_left_foot(name: &str) {
         "{name}: base {lean} rad off the commanded posture"
     );
 
-    move_joints(
-        &mut sim,
-        lifted.joints.as_slice(),
-        shifted.joints.as_slice(),
-        1.0,
-    );
-    move_joints(&mut sim, shifted.joints.as_slice(), &standing, 1.5);
-    let m = sim.measurement();
+    move_joints(&mut sim, lifted_q, shifted_q, 1.0);
+    move_joints(&mut sim, shifted_q, standing, 1.5);
     assert_eq!(
-        m.contacts[..2],
+        sim.measurement().contacts[..2],
         [true, true],
         "{name}: both feet down again"
     );

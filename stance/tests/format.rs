@@ -36,6 +36,14 @@ fn read_edited(edit: impl FnOnce(&mut Value)) -> Result<RawSequence, FormatError
     RawSequence::from_json_str(&value.to_string(), &common::jvrc1().0)
 }
 
+/// `file` (JSON) with the number at `pointer` spelled `literal`: NaN, -Infinity, 1e999 and the
+/// like, which are not finite JSON numbers and so cannot be written through `serde_json`.
+fn with_number_spelled(file: &str, pointer: &str, literal: &str) -> String {
+    let mut value: Value = serde_json::from_str(file).unwrap();
+    *value.pointer_mut(pointer).expect("the field exists") = json!(12345.678);
+    value.to_string().replace("12345.678", literal)
+}
+
 #[test]
 fn raw_and_post_processed_files_round_trip() {
     let (robot, _) = common::jvrc1();
@@ -72,31 +80,22 @@ fn truncated_json_is_refused_with_its_position() {
 #[test]
 fn nan_is_refused_naming_stance_and_field() {
     let text = raw().to_json_string();
-    let mut value: Value = serde_json::from_str(&text).unwrap();
-    value["stances"][3]["q"][5] = json!(12345.678);
-    let text = value.to_string().replace("12345.678", "NaN");
-    let err = RawSequence::from_json_str(&text, &common::jvrc1().0).unwrap_err();
-    assert_eq!(
-        err,
-        FormatError::NonFinite {
-            location: Location::stance(3, "q[5]")
-        },
-        "{err}"
-    );
+    let read = |literal: &str| {
+        let edited = with_number_spelled(&text, "/stances/3/q/5", literal);
+        RawSequence::from_json_str(&edited, &common::jvrc1().0).unwrap_err()
+    };
+    let non_finite = FormatError::NonFinite {
+        location: Location::stance(3, "q[5]"),
+    };
+    let err = read("NaN");
+    assert_eq!(err, non_finite, "{err}");
     assert_eq!(
         err.to_string(),
         "stance 3, field `q[5]`: non-finite number (NaN or infinity) is not allowed"
     );
     // An overflowing number is an infinity: refused the same way.
-    let text = value.to_string().replace("12345.678", "1e999");
-    let err = RawSequence::from_json_str(&text, &common::jvrc1().0).unwrap_err();
-    assert_eq!(
-        err,
-        FormatError::NonFinite {
-            location: Location::stance(3, "q[5]")
-        },
-        "{err}"
-    );
+    let err = read("1e999");
+    assert_eq!(err, non_finite, "{err}");
 }
 
 #[test]
@@ -207,36 +206,24 @@ fn structural_errors_name_their_field() {
 #[test]
 fn files_of_the_other_kind_are_refused() {
     let (robot, _) = common::jvrc1();
+    // The kind a refusal of the wrong kind of file expected.
+    let expected = |err: FormatError| match err {
+        FormatError::WrongKind { expected, .. } => expected,
+        other => panic!("{other}"),
+    };
     let err = RawSequence::from_json_str(&processed().to_json_string(), robot).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            FormatError::WrongKind {
-                expected: "raw",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_eq!(expected(err), "raw");
     let err = PostProcessedSequence::from_json_str(&raw().to_json_string(), robot).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            FormatError::WrongKind {
-                expected: "post_processed",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_eq!(expected(err), "post_processed");
 }
 
 #[test]
 fn post_processed_target_nan_is_refused() {
-    let text = processed().to_json_string();
-    let mut value: Value = serde_json::from_str(&text).unwrap();
-    value["stances"][2]["targets"]["left_hand"]["translation"][1] = json!(12345.678);
-    let text = value.to_string().replace("12345.678", "-Infinity");
+    let text = with_number_spelled(
+        &processed().to_json_string(),
+        "/stances/2/targets/left_hand/translation/1",
+        "-Infinity",
+    );
     let err = PostProcessedSequence::from_json_str(&text, &common::jvrc1().0).unwrap_err();
     assert_eq!(
         err,

@@ -4,14 +4,30 @@
 use std::path::{Path, PathBuf};
 
 use stance::learned::{
-    EventKind, GaitEvent, LearnError, SegmentOptions, foot_events, load_folder, segment,
-    taxonomy_label,
+    EventKind, GaitEvent, LearnError, SegmentOptions, Segmentation, foot_events, load_folder,
+    segment, taxonomy_label,
 };
 
 fn corpus(folder: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../data/demonstrations")
         .join(folder)
+}
+
+/// The first demonstration of the corpus folder `folder`, segmented with the default options.
+fn segment_first(folder: &str) -> Segmentation {
+    let demos = load_folder(&corpus(folder)).unwrap();
+    segment(&demos[0], &SegmentOptions::default())
+}
+
+/// How many stances of `segmentation` have contacts (left foot, right foot, left hand, right
+/// hand) for which `holds` is true.
+fn stances_where(segmentation: &Segmentation, holds: impl Fn([bool; 4]) -> bool) -> usize {
+    segmentation
+        .keyframes
+        .iter()
+        .filter(|k| holds(k.contacts))
+        .count()
 }
 
 /// Mean absolute error between each annotated event (inside the detectable range) and the
@@ -77,13 +93,8 @@ fn gaitalytics_events_are_reproduced_within_50_ms() {
 
 #[test]
 fn gaitkit_overground_walk_segments_into_steps() {
-    let demos = load_folder(&corpus("gaitkit")).unwrap();
-    let segmentation = segment(&demos[0], &SegmentOptions::default());
-    let singles = segmentation
-        .keyframes
-        .iter()
-        .filter(|k| k.contacts[0] != k.contacts[1])
-        .count();
+    let segmentation = segment_first("gaitkit");
+    let singles = stances_where(&segmentation, |c| c[0] != c[1]);
     assert!(singles >= 3, "{singles} single-support stances");
     let forward: f64 = segmentation
         .keyframes
@@ -95,13 +106,8 @@ fn gaitkit_overground_walk_segments_into_steps() {
 
 #[test]
 fn climbing_has_hand_supported_stances() {
-    let demos = load_folder(&corpus("holosoma-climb")).unwrap();
-    let segmentation = segment(&demos[0], &SegmentOptions::default());
-    let with_hands = segmentation
-        .keyframes
-        .iter()
-        .filter(|k| k.contacts[2] || k.contacts[3])
-        .count();
+    let segmentation = segment_first("holosoma-climb");
+    let with_hands = stances_where(&segmentation, |c| c[2] || c[3]);
     assert!(
         with_hands >= 2,
         "{with_hands} hand-supported stances of {}",
@@ -115,28 +121,29 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// Writes the manifest of `dir` naming one trial, the C3D file `file` (walking along −y, +z up).
+fn write_c3d_manifest(dir: &Path, file: &str) {
+    std::fs::write(
+        dir.join("demo.toml"),
+        format!("[[trial]]\nfile = \"{file}\"\nformat = \"c3d\"\nforward = \"-y\"\nup = \"+z\"\n"),
+    )
+    .unwrap();
+}
+
 #[test]
 fn corrupt_c3d_is_refused_with_the_file_named() {
     let dir = scratch("corrupt");
     let bytes = std::fs::read(corpus("gaitalytics").join("treadmill_events.c3d")).unwrap();
     std::fs::write(dir.join("cut.c3d"), &bytes[..bytes.len() / 2]).unwrap();
     std::fs::write(dir.join("junk.c3d"), b"this is not a c3d file at all").unwrap();
-    std::fs::write(
-        dir.join("demo.toml"),
-        "[[trial]]\nfile = \"cut.c3d\"\nformat = \"c3d\"\nforward = \"-y\"\nup = \"+z\"\n",
-    )
-    .unwrap();
+    write_c3d_manifest(&dir, "cut.c3d");
     let error = load_folder(&dir).unwrap_err();
     assert!(matches!(error, LearnError::Truncated { .. }), "{error}");
     assert!(
         error.to_string().contains("cut.c3d") && error.to_string().contains("point data"),
         "{error}"
     );
-    std::fs::write(
-        dir.join("demo.toml"),
-        "[[trial]]\nfile = \"junk.c3d\"\nformat = \"c3d\"\nforward = \"-y\"\nup = \"+z\"\n",
-    )
-    .unwrap();
+    write_c3d_manifest(&dir, "junk.c3d");
     let error = load_folder(&dir).unwrap_err().to_string();
     assert!(
         error.contains("junk.c3d") && error.contains("not a C3D file"),
@@ -159,11 +166,7 @@ fn unknown_marker_set_is_refused_with_the_missing_labels() {
     }
     assert!(renamed >= 1);
     std::fs::write(dir.join("renamed.c3d"), &bytes).unwrap();
-    std::fs::write(
-        dir.join("demo.toml"),
-        "[[trial]]\nfile = \"renamed.c3d\"\nformat = \"c3d\"\nforward = \"-y\"\nup = \"+z\"\n",
-    )
-    .unwrap();
+    write_c3d_manifest(&dir, "renamed.c3d");
     let error = load_folder(&dir).unwrap_err();
     let text = error.to_string();
     assert!(

@@ -5,8 +5,8 @@ use std::time::Duration;
 use client::daemon_client::SubmitError;
 use shm_types::{DaemonLoopPorts, DaemonState, LinkState, SensorSample, ServiceNames};
 use walk_tests::{
-    connect_when_fresh, start_sim, start_walkd, start_walking, unique_prefix, wait_for_status,
-    wait_until, walk_json,
+    start_connected, start_sim, start_walking, unique_prefix, wait_for_status, wait_until,
+    walk_json,
 };
 
 const START: Duration = Duration::from_secs(20);
@@ -100,9 +100,7 @@ fn daemon_killed_adapter_holds_position() {
 #[test]
 fn invalid_submissions_are_refused_and_a_walk_goes_on() {
     let prefix = unique_prefix("invalid_submissions");
-    let walkd = start_walkd("armar4", &prefix, "lockstep", 500.0).unwrap();
-    let _sim = start_sim("armar4", &prefix, "lockstep", 500.0).unwrap();
-    let client = connect_when_fresh(&prefix, START).unwrap();
+    let (walkd, _sim, client) = start_connected("armar4", &prefix, "lockstep").unwrap();
     let (json, _) = walk_json("armar4", 0.3).unwrap();
     let refused = |text: &str| match client.submit_json(text) {
         Err(SubmitError::Refused(reason)) => reason,

@@ -13,8 +13,8 @@ use walk_tests::hostile::{
     standing_sample,
 };
 use walk_tests::{
-    config, connect_when_fresh, start_sim, start_walkd, unique_prefix, wait_for_status, wait_until,
-    walk_json,
+    assert_terminates, config, start_connected, start_sim, start_walkd, unique_prefix,
+    wait_for_status, wait_until, walk_json,
 };
 
 const START: Duration = Duration::from_secs(20);
@@ -126,9 +126,7 @@ fn a_sample_stamped_in_the_future_does_not_freeze_the_control_thread() {
     let started = Instant::now();
     client.control(shm_types::ControlCommand::Hold).unwrap();
     assert!(started.elapsed() < Duration::from_secs(1));
-    walkd.signal(libc::SIGTERM);
-    let exit = walkd.wait_exit(Duration::from_secs(1));
-    assert_eq!(exit.and_then(|s| s.code()), Some(0), "{}", walkd.log());
+    assert_terminates(&walkd, Duration::from_secs(1));
 }
 
 /// Item 3: joints measured outside their limits are a fault naming the joint; no walk starts,
@@ -186,11 +184,9 @@ fn joints_measured_outside_their_limits_fault_and_commands_stay_inside() {
 #[test]
 fn an_adapter_restart_holds_the_new_posture_and_tipping_can_be_acknowledged() {
     let prefix = unique_prefix("hostile_restart");
-    let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
-    let sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
+    let (walkd, sim, client) = start_connected("armar4", &prefix, "realtime").unwrap();
     let robot = robot("armar4");
     let dof = robot.model.dof();
-    let client = connect_when_fresh(&prefix, START).unwrap();
     let (json, _) = walk_json("armar4", 1.0).unwrap();
     client.submit_json(&json).unwrap();
     std::thread::sleep(Duration::from_secs(3));
@@ -285,9 +281,7 @@ fn repeated_stances(json: &str, count: usize) -> String {
 #[test]
 fn submissions_are_bounded_and_busy_is_decided_before_parsing() {
     let prefix = unique_prefix("hostile_size");
-    let walkd = start_walkd("armar4", &prefix, "lockstep", 500.0).unwrap();
-    let _sim = start_sim("armar4", &prefix, "lockstep", 500.0).unwrap();
-    let client = connect_when_fresh(&prefix, START).unwrap();
+    let (walkd, _sim, client) = start_connected("armar4", &prefix, "lockstep").unwrap();
     let raw = RawClient::connect(&prefix).unwrap();
     let (json, _) = walk_json("armar4", 0.3).unwrap();
 
@@ -337,9 +331,7 @@ fn rss_kib(pid: u32) -> u64 {
 #[test]
 fn targets_outside_the_workspace_are_refused() {
     let prefix = unique_prefix("hostile_targets");
-    let _walkd = start_walkd("armar4", &prefix, "lockstep", 500.0).unwrap();
-    let _sim = start_sim("armar4", &prefix, "lockstep", 500.0).unwrap();
-    let client = connect_when_fresh(&prefix, START).unwrap();
+    let (_walkd, _sim, client) = start_connected("armar4", &prefix, "lockstep").unwrap();
     let (json, _) = walk_json("armar4", 0.3).unwrap();
     for x in [1e300, 1e6, 50.0] {
         let mut value: serde_json::Value = serde_json::from_str(&json).unwrap();
@@ -456,9 +448,7 @@ fn a_greedy_process_cannot_lock_out_monitoring_or_the_adapter() {
 #[test]
 fn refusals_use_no_id_a_dead_walkd_is_named_at_once_and_bad_commands_do_not_flood_the_log() {
     let prefix = unique_prefix("hostile_small");
-    let walkd = start_walkd("armar4", &prefix, "realtime", 500.0).unwrap();
-    let sim = start_sim("armar4", &prefix, "realtime", 500.0).unwrap();
-    let client = connect_when_fresh(&prefix, START).unwrap();
+    let (walkd, sim, client) = start_connected("armar4", &prefix, "realtime").unwrap();
     let (json, _) = walk_json("armar4", 0.3).unwrap();
     assert!(client.submit_json("{ not json").is_err());
     assert_eq!(

@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use shm_types::LinkState;
 use walk_tests::{
-    connect_when_fresh, start_sim, start_walkd, start_walkd_with_env, start_walking, unique_prefix,
-    walk_json,
+    assert_terminates, connect_when_fresh, start_connected, start_sim, start_walkd,
+    start_walkd_with_env, start_walking, unique_prefix, walk_json,
 };
 
 const START: Duration = Duration::from_secs(20);
@@ -41,9 +41,7 @@ fn walkd_exits_cleanly_within_one_second_on_sigterm_and_sigint() {
         );
 
         // The adapter saw the final hold command and holds on its own once commands stop.
-        sim.signal(libc::SIGTERM);
-        let status = sim.wait_exit(Duration::from_secs(5));
-        assert_eq!(status.and_then(|s| s.code()), Some(0), "{}", sim.log());
+        assert_terminates(&sim, Duration::from_secs(5));
     }
 }
 
@@ -52,9 +50,7 @@ fn walkd_exits_cleanly_within_one_second_on_sigterm_and_sigint() {
 #[test]
 fn walkd_restarts_after_kill_9_and_cleans_stale_resources() {
     let prefix = unique_prefix("restart");
-    let first = start_walkd("armar4", &prefix, "lockstep", 500.0).unwrap();
-    let _sim = start_sim("armar4", &prefix, "lockstep", 500.0).unwrap();
-    let client = connect_when_fresh(&prefix, START).unwrap();
+    let (first, _sim, client) = start_connected("armar4", &prefix, "lockstep").unwrap();
     let first_pid = client.status().unwrap().pid;
     assert_eq!(first_pid, first.pid());
     drop(client);

@@ -20,6 +20,7 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::{publish_subscribe, request_response};
 use kinematics::robot::{EndEffector, Robot};
 use shm_types::{
     ControlReply, ControlRequest, DaemonStatus, JointCommand, MAX_JOINTS, SensorSample, SubmitReply,
@@ -54,39 +55,38 @@ impl<T: Copy> Raw<T> {
         }
     }
 
-    /// Writes `value` at byte `offset`, whatever the field there is declared as.
-    pub fn put<V: Copy>(&mut self, offset: usize, value: V) {
+    /// Panics unless a `V` at byte `offset` lies inside the message (`access`: read or write).
+    fn assert_inside<V>(offset: usize, access: &str) {
         assert!(
             offset + size_of::<V>() <= size_of::<T>(),
-            "write past the message"
+            "{access} past the message"
         );
+    }
+
+    /// Writes `value` at byte `offset`, whatever the field there is declared as.
+    pub fn put<V: Copy>(&mut self, offset: usize, value: V) {
+        Self::assert_inside::<V>(offset, "write");
+        let at = self
+            .bytes
+            .as_mut_ptr()
+            .wrapping_byte_add(offset)
+            .cast::<V>();
         // SAFETY: in bounds (checked above); unaligned write of plain bytes into owned memory.
-        unsafe {
-            self.bytes
-                .as_mut_ptr()
-                .cast::<u8>()
-                .add(offset)
-                .cast::<V>()
-                .write_unaligned(value)
-        }
+        unsafe { at.write_unaligned(value) }
+    }
+
+    /// Writes the monotonic clock's now (ns) at byte `offset`: a message's `timestamp_ns`.
+    pub fn stamp(&mut self, offset: usize) {
+        self.put(offset, shm_types::monotonic_ns());
     }
 
     /// Reads a `V` at byte `offset` (any bit pattern is a valid `V` for the integer and float
     /// types used here).
     pub fn get<V: Copy>(&self, offset: usize) -> V {
-        assert!(
-            offset + size_of::<V>() <= size_of::<T>(),
-            "read past the message"
-        );
+        Self::assert_inside::<V>(offset, "read");
+        let at = self.bytes.as_ptr().wrapping_byte_add(offset).cast::<V>();
         // SAFETY: in bounds (checked above); the bytes were written by a sender or `put`.
-        unsafe {
-            self.bytes
-                .as_ptr()
-                .cast::<u8>()
-                .add(offset)
-                .cast::<V>()
-                .read_unaligned()
-        }
+        unsafe { at.read_unaligned() }
     }
 
     /// Reads a `FixedText` field at `offset` (its `len: u32` then the bytes), lossily.
@@ -115,6 +115,27 @@ fn service_name(prefix: &str, kind: &str) -> anyhow::Result<ServiceName> {
     Ok(ServiceName::new(&format!("{prefix}/{kind}"))?)
 }
 
+/// Opens the publish-subscribe service `kind` under `prefix` (its owner created it) for raw `T`
+/// messages.
+fn open_stream<T: Copy + ZeroCopySend + 'static>(
+    node: &Node<ipc::Service>,
+    prefix: &str,
+    kind: &str,
+) -> anyhow::Result<publish_subscribe::PortFactory<ipc::Service, Raw<T>, ()>> {
+    node.service_builder(&service_name(prefix, kind)?)
+        .publish_subscribe::<Raw<T>>()
+        .open()
+        .map_err(|e| anyhow::anyhow!("opening {kind}: {e:?}"))
+}
+
+/// Opens walkd's `control` service under `prefix` for raw requests and replies.
+fn open_control(node: &Node<ipc::Service>, prefix: &str) -> anyhow::Result<RawControlService> {
+    node.service_builder(&service_name(prefix, "control")?)
+        .request_response::<Raw<ControlRequest>, Raw<ControlReply>>()
+        .open()
+        .map_err(|e| anyhow::anyhow!("opening control: {e:?}"))
+}
+
 /// A sample of `robot` standing still in its configured posture, its weight shared by the feet.
 pub fn standing_sample(robot: &Robot) -> SensorSample {
     let mut sample = SensorSample::ZERO;
@@ -139,14 +160,9 @@ struct RawSender<T: Copy + ZeroCopySend + 'static> {
 impl<T: Copy + ZeroCopySend + 'static> RawSender<T> {
     /// Opens the stream `kind` under `prefix` (its other end created it).
     fn open(node: &Node<ipc::Service>, prefix: &str, kind: &str) -> anyhow::Result<Self> {
-        let name = service_name(prefix, kind)?;
-        let stream = node
-            .service_builder(&name)
-            .publish_subscribe::<Raw<T>>()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening {kind}: {e:?}"))?;
+        let stream = open_stream::<T>(node, prefix, kind)?;
         let event = node
-            .service_builder(&name)
+            .service_builder(&service_name(prefix, kind)?)
             .event()
             .open()
             .map_err(|e| anyhow::anyhow!("opening the {kind} event: {e:?}"))?;
@@ -185,11 +201,7 @@ impl RawAdapter {
     /// Opens walkd's `sensors` and `commands` services under `prefix` (walkd created them).
     pub fn open(prefix: &str) -> anyhow::Result<Self> {
         let node = node("hostile-adapter")?;
-        let commands = node
-            .service_builder(&service_name(prefix, "commands")?)
-            .publish_subscribe::<Raw<JointCommand>>()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening commands: {e:?}"))?;
+        let commands = open_stream::<JointCommand>(&node, prefix, "commands")?;
         Ok(Self {
             sensors: RawSender::open(&node, prefix, "sensors")?,
             commands: commands
@@ -215,10 +227,7 @@ impl RawAdapter {
         edit: impl FnOnce(&mut Raw<SensorSample>),
     ) -> u64 {
         let mut raw = Raw::of(*sample);
-        raw.put(
-            offset_of!(SensorSample, timestamp_ns),
-            shm_types::monotonic_ns(),
-        );
+        raw.stamp(offset_of!(SensorSample, timestamp_ns));
         edit(&mut raw);
         self.publish_raw(raw)
     }
@@ -227,10 +236,7 @@ impl RawAdapter {
     /// timestamp is replaced by now); returns the sequence number.
     pub fn publish_raw(&mut self, mut raw: Raw<SensorSample>) -> u64 {
         if raw.get::<u64>(offset_of!(SensorSample, timestamp_ns)) == 0 {
-            raw.put(
-                offset_of!(SensorSample, timestamp_ns),
-                shm_types::monotonic_ns(),
-            );
+            raw.stamp(offset_of!(SensorSample, timestamp_ns));
         }
         self.sensors.send(raw, offset_of!(SensorSample, seq))
     }
@@ -355,10 +361,7 @@ impl RawDaemon {
     /// Publishes `command` (numbered and stamped) after `edit` changed its raw bytes.
     pub fn publish(&mut self, command: &JointCommand, edit: impl FnOnce(&mut Raw<JointCommand>)) {
         let mut raw = Raw::of(*command);
-        raw.put(
-            offset_of!(JointCommand, timestamp_ns),
-            shm_types::monotonic_ns(),
-        );
+        raw.stamp(offset_of!(JointCommand, timestamp_ns));
         edit(&mut raw);
         self.commands.send(raw, offset_of!(JointCommand, seq));
     }
@@ -377,6 +380,9 @@ pub fn command_answers(command: &Raw<JointCommand>) -> u64 {
 
 /// A client port of `control` with raw messages.
 type RawControlClient = Client<ipc::Service, Raw<ControlRequest>, (), Raw<ControlReply>, ()>;
+/// walkd's `control` service with raw messages.
+type RawControlService =
+    request_response::PortFactory<ipc::Service, Raw<ControlRequest>, (), Raw<ControlReply>, ()>;
 
 /// A client that sends raw control requests and raw submissions.
 pub struct RawClient {
@@ -389,11 +395,7 @@ impl RawClient {
     /// Opens walkd's `control` and `stances` services under `prefix`.
     pub fn connect(prefix: &str) -> anyhow::Result<Self> {
         let node = node("hostile-client")?;
-        let control = node
-            .service_builder(&service_name(prefix, "control")?)
-            .request_response::<Raw<ControlRequest>, Raw<ControlReply>>()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening control: {e:?}"))?;
+        let control = open_control(&node, prefix)?;
         let stances = node
             .service_builder(&service_name(prefix, "stances")?)
             .request_response::<[u8], Raw<SubmitReply>>()
@@ -476,21 +478,9 @@ impl PortHog {
     /// Takes the ports under `prefix`.
     pub fn take(prefix: &str, limit: usize, publishers: usize) -> anyhow::Result<Self> {
         let node = node("hostile-hog")?;
-        let control = node
-            .service_builder(&service_name(prefix, "control")?)
-            .request_response::<Raw<ControlRequest>, Raw<ControlReply>>()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening control: {e:?}"))?;
-        let status = node
-            .service_builder(&service_name(prefix, "status")?)
-            .publish_subscribe::<Raw<DaemonStatus>>()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening status: {e:?}"))?;
-        let sensors = node
-            .service_builder(&service_name(prefix, "sensors")?)
-            .publish_subscribe::<Raw<SensorSample>>()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening sensors: {e:?}"))?;
+        let control = open_control(&node, prefix)?;
+        let status = open_stream::<DaemonStatus>(&node, prefix, "status")?;
+        let sensors = open_stream::<SensorSample>(&node, prefix, "sensors")?;
         let control: Vec<_> = (0..limit)
             .map_while(|_| control.client_builder().create().ok())
             .collect();

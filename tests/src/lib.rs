@@ -153,6 +153,22 @@ pub fn wait_for_status(
     })
 }
 
+/// How long a test waits for walkd and walk-sim to come up and link.
+const START: Duration = Duration::from_secs(20);
+
+/// Starts walkd and walk-sim for `robot` on `prefix` at 500 Hz on `clock` (`realtime` or
+/// `lockstep`); returns (walkd, walk-sim, a client) once the adapter link is fresh.
+pub fn start_connected(
+    robot: &str,
+    prefix: &str,
+    clock: &str,
+) -> anyhow::Result<(Process, Process, DaemonClient)> {
+    let walkd = start_walkd(robot, prefix, clock, 500.0)?;
+    let sim = start_sim(robot, prefix, clock, 500.0)?;
+    let client = connect_when_fresh(prefix, START)?;
+    Ok((walkd, sim, client))
+}
+
 /// Starts walkd and walk-sim for `robot` on `prefix` in real time at 500 Hz and submits a walk of
 /// `distance` metres; returns (walkd, walk-sim, a client) once it executes.
 pub fn start_walking(
@@ -160,16 +176,21 @@ pub fn start_walking(
     prefix: &str,
     distance: f64,
 ) -> anyhow::Result<(Process, Process, DaemonClient)> {
-    let start = Duration::from_secs(20);
-    let walkd = start_walkd(robot, prefix, "realtime", 500.0)?;
-    let sim = start_sim(robot, prefix, "realtime", 500.0)?;
-    let client = connect_when_fresh(prefix, start)?;
+    let (walkd, sim, client) = start_connected(robot, prefix, "realtime")?;
     let (json, _) = walk_json(robot, distance)?;
     client.submit_json(&json)?;
-    wait_for_status(&client, "executing", start, |s| {
+    wait_for_status(&client, "executing", START, |s| {
         s.state == shm_types::DaemonState::Executing
     })?;
     Ok((walkd, sim, client))
+}
+
+/// Sends SIGTERM to `process` and asserts that it exits with status 0 within `within` (its log
+/// otherwise).
+pub fn assert_terminates(process: &Process, within: Duration) {
+    process.signal(libc::SIGTERM);
+    let exit = process.wait_exit(within);
+    assert_eq!(exit.and_then(|s| s.code()), Some(0), "{}", process.log());
 }
 
 /// A post-processed forward walk of `distance` metres for `robot` (JSON) and its stance count.

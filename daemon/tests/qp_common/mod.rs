@@ -2,7 +2,7 @@
 //! certificate independent of any solver, and an exact KKT solve at a given active set.
 #![allow(dead_code)] // each test binary uses a different subset
 
-use daemon::qp::QpProblem;
+use daemon::qp::{QpInfo, QpProblem};
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -33,6 +33,13 @@ pub struct Shape {
     pub n: usize,
     pub m_eq: usize,
     pub m_ineq: usize,
+}
+
+impl Shape {
+    /// `n` variables, `m_eq` equality rows and `m_ineq` inequality rows.
+    pub const fn new(n: usize, m_eq: usize, m_ineq: usize) -> Self {
+        Self { n, m_eq, m_ineq }
+    }
 }
 
 fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
@@ -71,13 +78,13 @@ fn tasks(
     (p, q)
 }
 
-/// Solves the equality-constrained QP `min ½xᵀPx + qᵀx, A x = b` through its KKT system.
-pub fn equality_optimum(
+/// The KKT system `[P Aᵀ; A 0] [x; ν] = [−q; b]` of `min ½xᵀPx + qᵀx, A x = b`.
+fn kkt_system(
     p: &DMatrix<f64>,
     q: &DVector<f64>,
     a: &DMatrix<f64>,
     b: &DVector<f64>,
-) -> DVector<f64> {
+) -> (DMatrix<f64>, DVector<f64>) {
     let (n, m) = (p.nrows(), a.nrows());
     let mut k = DMatrix::zeros(n + m, n + m);
     k.view_mut((0, 0), (n, n)).copy_from(p);
@@ -86,11 +93,22 @@ pub fn equality_optimum(
     let mut rhs = DVector::zeros(n + m);
     rhs.rows_mut(0, n).copy_from(&(-q));
     rhs.rows_mut(n, m).copy_from(b);
+    (k, rhs)
+}
+
+/// Solves the equality-constrained QP `min ½xᵀPx + qᵀx, A x = b` through its KKT system.
+pub fn equality_optimum(
+    p: &DMatrix<f64>,
+    q: &DVector<f64>,
+    a: &DMatrix<f64>,
+    b: &DVector<f64>,
+) -> DVector<f64> {
+    let (k, rhs) = kkt_system(p, q, a, b);
     let sol = k
         .lu()
         .solve(&rhs)
         .expect("KKT matrix of a generated problem is regular");
-    sol.rows(0, n).into_owned()
+    sol.rows(0, p.nrows()).into_owned()
 }
 
 /// A seeded controller-like strictly convex QP that is feasible by construction.
@@ -170,39 +188,32 @@ pub fn rows(problem: &QpProblem) -> Vec<Row> {
     }
     for i in 0..problem.m_ineq() {
         let row = problem.c().row(i).transpose();
-        if problem.l()[i].is_finite() {
-            out.push(Row {
-                normal: row.clone(),
-                rhs: problem.l()[i],
-                equality: false,
-            });
-        }
-        if problem.u()[i].is_finite() {
-            out.push(Row {
-                normal: -row,
-                rhs: -problem.u()[i],
-                equality: false,
-            });
-        }
+        push_sides(&mut out, row, problem.l()[i], problem.u()[i]);
     }
     for j in 0..n {
         let e = DVector::from_fn(n, |i, _| if i == j { 1.0 } else { 0.0 });
-        if problem.x_min()[j].is_finite() {
-            out.push(Row {
-                normal: e.clone(),
-                rhs: problem.x_min()[j],
-                equality: false,
-            });
-        }
-        if problem.x_max()[j].is_finite() {
-            out.push(Row {
-                normal: -e,
-                rhs: -problem.x_max()[j],
-                equality: false,
-            });
-        }
+        push_sides(&mut out, e, problem.x_min()[j], problem.x_max()[j]);
     }
     out
+}
+
+/// The rows `normalᵀ x ≥ lo` and `−normalᵀ x ≥ −hi` of a two-sided constraint, each only if
+/// that side is finite.
+fn push_sides(out: &mut Vec<Row>, normal: DVector<f64>, lo: f64, hi: f64) {
+    if lo.is_finite() {
+        out.push(Row {
+            normal: normal.clone(),
+            rhs: lo,
+            equality: false,
+        });
+    }
+    if hi.is_finite() {
+        out.push(Row {
+            normal: -normal,
+            rhs: -hi,
+            equality: false,
+        });
+    }
 }
 
 /// Residuals of the KKT conditions at `x`, each scaled to be dimensionless.
@@ -275,6 +286,18 @@ pub fn kkt(problem: &QpProblem, x: &DVector<f64>, active_tol: f64) -> Kkt {
     }
 }
 
+/// Asserts that `x`, the solution `info` reports, satisfies the KKT conditions of `problem` to
+/// 1e-9 and that `info` counts the active inequalities the certificate finds; `case` names the
+/// problem in the messages.
+pub fn assert_certified(problem: &QpProblem, x: &DVector<f64>, info: &QpInfo, case: &str) {
+    let cert = kkt(problem, x, 1e-9);
+    assert!(cert.worst() <= 1e-9, "{case}: dense KKT residuals {cert:?}");
+    assert_eq!(
+        info.active_constraints, cert.active,
+        "{case}: reported vs certified active count"
+    );
+}
+
 /// The exact optimum for the active set identified at `x` (rows with scaled slack ≤
 /// `active_tol`): the KKT system with those rows as equalities, solved by LU with one step of
 /// iterative refinement.
@@ -291,19 +314,17 @@ pub fn exact_at_active_set(problem: &QpProblem, x: &DVector<f64>, active_tol: f6
     let b = DVector::from_fn(active.len(), |i, _| active[i].rhs);
     let p = problem.p().into_owned();
     let q = problem.q().into_owned();
-    let (n, m) = (p.nrows(), a.nrows());
-    let mut k = DMatrix::zeros(n + m, n + m);
-    k.view_mut((0, 0), (n, n)).copy_from(&p);
-    k.view_mut((n, 0), (m, n)).copy_from(&a);
-    k.view_mut((0, n), (n, m)).copy_from(&a.transpose());
-    let mut rhs = DVector::zeros(n + m);
-    rhs.rows_mut(0, n).copy_from(&(-q));
-    rhs.rows_mut(n, m).copy_from(&b);
+    let (k, rhs) = kkt_system(&p, &q, &a, &b);
     let lu = k.clone().lu();
     let mut sol = lu.solve(&rhs).expect("regular KKT system");
     let correction = lu.solve(&(&rhs - &k * &sol)).expect("regular KKT system");
     sol += correction;
-    sol.rows(0, n).into_owned()
+    sol.rows(0, p.nrows()).into_owned()
+}
+
+/// |a − b| / (1 + |b|), for objective values.
+pub fn rel_gap(a: f64, b: f64) -> f64 {
+    (a - b).abs() / (1.0 + b.abs())
 }
 
 /// ‖a − b‖∞ / (1 + ‖b‖∞).
