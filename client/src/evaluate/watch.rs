@@ -12,7 +12,7 @@ use shm_types::{DaemonStatus, SimTruth};
 use stance::PostProcessedSequence;
 
 use super::balance::BalanceRecorder;
-use super::truth::{TruthRecorder, Verdict};
+use super::truth::{TruthRecorder, Verdict, state_at};
 use super::{BalanceSample, Points, TraceSample, align_targets, pair_with_truth, pose_of, sample};
 use crate::daemon_client::DaemonClient;
 use crate::observe::{Recorder, RecorderOutcome};
@@ -40,7 +40,7 @@ pub(crate) struct WatchedWalk {
     pub settled: DaemonStatus,
     /// Wall time from submission to the end (s).
     pub wall_s: f64,
-    /// Simulated (control-tick) time from submission to the end (s).
+    /// Simulated time from submission to the walk's last status (s).
     pub sim_s: f64,
     /// Monotonic time of the submission (ns).
     pub submitted_ns: u64,
@@ -106,8 +106,18 @@ pub(crate) fn watch_walk(
         None => Vec::new(),
     };
     let drift = pair_with_truth(&mut trace, &status_times, &states);
+    // Simulated time from the submission to the tick of the last status: by the simulator's
+    // clock where it published its truth (the ticks between the status read before submitting
+    // and the submission are no part of the walk), else by walkd's ticks.
+    let sim_s = match (
+        state_at(&states, submitted_ns),
+        state_at(&states, last.timestamp_ns),
+    ) {
+        (Some(submitted), Some(end)) => end.sim_time_s - submitted.sim_time_s,
+        _ => last.ticks.saturating_sub(start.ticks) as f64 / last.rate_hz,
+    };
     Ok(WatchedWalk {
-        sim_s: last.ticks.saturating_sub(start.ticks) as f64 / last.rate_hz,
+        sim_s,
         verdict: Verdict::of(&states, submitted_ns),
         start,
         last,
