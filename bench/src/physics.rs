@@ -158,19 +158,12 @@ pub struct PhysicsWalkReport {
     pub max_com_drift_m: f64,
     /// Largest controller-vs-simulator sole distance over the walk (m).
     pub max_foot_drift_m: f64,
-    /// Controller-vs-simulator CoM and sole distances at the end (m).
-    pub final_drift_m: (f64, f64),
     /// Horizontal distance the simulated feet midpoint travelled (m).
     pub distance_m: f64,
     /// Largest horizontal slip of a foot in contact since its touchdown (m).
     pub max_contact_slip_m: f64,
-    /// Smallest static stability margin of the simulated CoM over the ticks with a foot on the
-    /// floor (m; negative = outside the support polygon).
-    pub min_stability_margin_m: f64,
     /// Largest tilt of the base link from vertical seen (rad).
     pub max_tilt_rad: f64,
-    /// Lowest base-link height over its initial height.
-    pub min_base_height_ratio: f64,
     /// The Fig. 6 trace (every [`PhysicsWalkOptions::trace_every`] ticks), with the simulator's
     /// truth; draw it with `client::evaluate::write_fig6`.
     pub trace: Vec<TraceSample>,
@@ -306,14 +299,11 @@ pub fn walk_sequence(
         sequence,
         &FEET.map(|f| closed.sim.end_effector_pose(f)),
     );
-    let initial_height = closed.sim.base_height();
     let mut loop_state = LoopState {
         trace: Vec::with_capacity((max_ticks / options.trace_every.max(1)).min(1 << 20) as usize),
         max_com_drift: 0.0,
         max_foot_drift: 0.0,
         max_tilt: 0.0,
-        min_height: initial_height,
-        min_margin: f64::INFINITY,
         controller_time: Duration::ZERO,
         physics_time: Duration::ZERO,
         tick_ns: Vec::with_capacity(max_ticks.min(1 << 22) as usize),
@@ -365,8 +355,6 @@ pub fn walk_sequence(
         }
     };
     let sim_s = closed.sim.time();
-    let end_drift =
-        sim_points(&closed.sim).distances(&controller_points(closed.controller.status()));
     if outcome == PhysicsOutcome::Done {
         for _ in 0..settle_ticks {
             if let Err(o) = loop_state.tick(&mut closed) {
@@ -400,12 +388,9 @@ pub fn walk_sequence(
         final_position_error_m,
         max_com_drift_m: loop_state.max_com_drift,
         max_foot_drift_m: loop_state.max_foot_drift,
-        final_drift_m: end_drift,
         distance_m: (feet_midpoint(sim) - start_midpoint).norm(),
         max_contact_slip_m: sim.summary().max_contact_slip,
-        min_stability_margin_m: loop_state.min_margin,
         max_tilt_rad: loop_state.max_tilt,
-        min_base_height_ratio: loop_state.min_height / initial_height,
         trace: loop_state.trace,
         first_step_s: loop_state.first_step_s,
         tick_us,
@@ -541,8 +526,6 @@ struct LoopState {
     max_com_drift: f64,
     max_foot_drift: f64,
     max_tilt: f64,
-    min_height: f64,
-    min_margin: f64,
     controller_time: Duration,
     physics_time: Duration,
     tick_ns: Vec<u64>,
@@ -597,11 +580,6 @@ impl LoopState {
         self.max_com_drift = self.max_com_drift.max(com);
         self.max_foot_drift = self.max_foot_drift.max(feet);
         self.max_tilt = self.max_tilt.max(sim.torso_tilt());
-        self.min_height = self.min_height.min(sim.base_height());
-        let m = sim.measurement();
-        if m.contacts.iter().any(|&c| c) {
-            self.min_margin = self.min_margin.min(m.safety.stability_margin);
-        }
     }
 }
 
