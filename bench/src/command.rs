@@ -49,8 +49,14 @@ impl From<SolverArg> for SolverKind {
     }
 }
 
-/// Arguments of `walk-bench`.
-#[derive(Debug, clap::Args)]
+/// Arguments of `walk-bench` (its whole command line).
+#[derive(Debug, clap::Parser)]
+#[command(
+    name = "walk-bench",
+    version,
+    about = "Generate (or read), post-process and execute a walk in-process against the kinematic \
+             simulator; report outcome, safety and timing."
+)]
 pub struct BenchArgs {
     /// Robot config (TOML with [robot], [postprocess], [controller], [runtime]).
     #[arg(long, value_name = "CONFIG")]

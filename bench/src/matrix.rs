@@ -17,8 +17,14 @@ use stance::{Gait, WalkRequest};
 
 use crate::physics::{PhysicsWalkOptions, PhysicsWalkReport, Push, walk_distance};
 
-/// Arguments of `physics-matrix`.
-#[derive(Debug, clap::Args)]
+/// Arguments of `physics-matrix` (its whole command line).
+#[derive(Debug, clap::Parser)]
+#[command(
+    name = "physics-matrix",
+    version,
+    about = "Walk affordance sets × distances × seeds under MuJoCo in one process; report each \
+             run and each group (done, speed, drift, tick time). Exit 0 when every walk is done."
+)]
 pub struct MatrixArgs {
     /// Robot config (TOML).
     #[arg(long, value_name = "CONFIG")]

@@ -2,16 +2,8 @@
 //! (`walk_bench::command`).
 
 use clap::Parser;
-
-/// Generate (or read), post-process and execute a walk in-process against the kinematic
-/// simulator; report outcome, safety and timing.
-#[derive(Parser)]
-#[command(name = "walk-bench", version, about)]
-struct Cli {
-    #[command(flatten)]
-    args: walk_bench::command::BenchArgs,
-}
+use walk_bench::command::BenchArgs;
 
 fn main() -> std::process::ExitCode {
-    walk_bench::command::main(&Cli::parse().args)
+    walk_bench::command::main(&BenchArgs::parse())
 }

@@ -46,8 +46,9 @@ use control_loop::{ControlLoop, LoopTiming};
 use service::{Acceptance, ServiceLoop, SubmissionLimits};
 use shared::Shared;
 
-/// Command line of the daemon (flattened into `walkd`'s top level).
-#[derive(Debug, Clone, clap::Args)]
+/// Command line of the daemon: `walkd`'s whole command line.
+#[derive(Debug, Clone, clap::Parser)]
+#[command(name = "walkd", version, about = "The real-time walking daemon.")]
 pub struct DaemonArgs {
     /// Robot config file (`[robot]`, `[controller]` and `[runtime]` are used).
     #[arg(long)]
