@@ -83,36 +83,20 @@ pub enum SimError {
         /// Height of the lowest sole corner above the ground.
         lowest_m: f64,
     },
-    /// A command vector has the wrong length.
-    #[error("command `{field}` has {actual} entries, the model has {expected} joints")]
-    CommandLength {
-        /// `q_des` or `qd_des`.
-        field: &'static str,
-        /// The model's joint count.
-        expected: usize,
-        /// The length given.
-        actual: usize,
-    },
-    /// A command entry is NaN or infinite.
-    #[error("command `{field}` joint {index} ({joint}) is not finite")]
-    NonFiniteCommand {
-        /// `q_des` or `qd_des`.
-        field: &'static str,
-        /// Joint index in model order.
-        index: usize,
-        /// Joint name.
-        joint: String,
-    },
+    /// A command vector has the wrong length or a non-finite entry.
+    #[error("command {0}")]
+    Command(#[from] JointVectorError),
     /// The time step is not positive and finite.
     #[error("time step {0} s is not positive and finite")]
     BadTimeStep(f64),
 }
 
 /// Why a joint vector handed to a simulator (a command, an initial posture) is unusable; every
-/// simulator back-end reports it through its own error type.
-#[derive(Debug, Clone, PartialEq)]
+/// simulator back-end carries it in its own error type.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum JointVectorError {
     /// Not one entry per model joint.
+    #[error("`{field}` has {actual} entries, the model has {expected} joints")]
     Length {
         /// Which vector (`q_des`, `qd_des`, `initial.joints`).
         field: &'static str,
@@ -122,6 +106,7 @@ pub enum JointVectorError {
         actual: usize,
     },
     /// An entry is NaN or infinite.
+    #[error("`{field}` joint {index} ({joint}) is not finite")]
     NonFinite {
         /// Which vector.
         field: &'static str,
@@ -154,31 +139,6 @@ pub fn check_joint_vector(
         });
     }
     Ok(())
-}
-
-impl From<JointVectorError> for SimError {
-    fn from(error: JointVectorError) -> Self {
-        match error {
-            JointVectorError::Length {
-                field,
-                expected,
-                actual,
-            } => SimError::CommandLength {
-                field,
-                expected,
-                actual,
-            },
-            JointVectorError::NonFinite {
-                field,
-                index,
-                joint,
-            } => SimError::NonFiniteCommand {
-                field,
-                index,
-                joint,
-            },
-        }
-    }
 }
 
 /// Safety metrics of the current state; the simulator also keeps their worst values.

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use kinematic_sim::{KinematicSim, SimError, SimOptions, Simulator};
+use kinematic_sim::{JointVectorError, KinematicSim, SimError, SimOptions, Simulator};
 use kinematics::ground::GRAVITY;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
@@ -151,11 +151,11 @@ fn commands_beyond_limits_stop_there_and_are_counted_and_bad_commands_are_refuse
     );
     q[arm] = f64::NAN;
     assert!(
-        matches!(sim.step(&q, &zeros, 0.002), Err(SimError::NonFiniteCommand { index, .. }) if index == arm)
+        matches!(sim.step(&q, &zeros, 0.002), Err(SimError::Command(JointVectorError::NonFinite { index, .. })) if index == arm)
     );
     assert!(matches!(
         sim.step(&q[1..], &zeros, 0.002),
-        Err(SimError::CommandLength { .. })
+        Err(SimError::Command(JointVectorError::Length { .. }))
     ));
 }
 

@@ -3,7 +3,7 @@
 //! Needs the `mujoco` feature (and the library: `eval "$(scripts/setup-mujoco.sh)"`).
 #![cfg(feature = "mujoco")]
 
-use kinematic_sim::Simulator;
+use kinematic_sim::{JointVectorError, Simulator};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -239,7 +239,10 @@ fn bad_commands_are_refused_with_the_reason() {
     let short = vec![0.0; n - 1];
     assert!(matches!(
         sim.step(&short, &ok, DT),
-        Err(MujocoError::CommandLength { field: "q_des", .. })
+        Err(MujocoError::JointVector(JointVectorError::Length {
+            field: "q_des",
+            ..
+        }))
     ));
     let mut nan = sim.robot().standing.joints.as_slice().to_vec();
     nan[3] = f64::NAN;
@@ -247,11 +250,11 @@ fn bad_commands_are_refused_with_the_reason() {
     assert!(
         matches!(
             err,
-            MujocoError::NonFiniteCommand {
+            MujocoError::JointVector(JointVectorError::NonFinite {
                 field: "q_des",
                 index: 3,
                 ..
-            }
+            })
         ),
         "{err}"
     );

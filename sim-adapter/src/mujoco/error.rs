@@ -42,26 +42,9 @@ pub enum MujocoError {
         /// What it must be.
         requirement: &'static str,
     },
-    /// A command (or initial) vector has the wrong length.
-    #[error("`{field}` has {actual} entries, the model has {expected} joints")]
-    CommandLength {
-        /// Which vector.
-        field: &'static str,
-        /// The model's joint count.
-        expected: usize,
-        /// The length given.
-        actual: usize,
-    },
-    /// A command (or initial joint) entry is NaN or infinite.
-    #[error("command `{field}` joint {index} ({joint}) is not finite")]
-    NonFiniteCommand {
-        /// `q_des` or `qd_des`.
-        field: &'static str,
-        /// Joint index in model order.
-        index: usize,
-        /// Joint name.
-        joint: String,
-    },
+    /// A command (or the initial joint vector) has the wrong length or a non-finite entry.
+    #[error("{0}")]
+    JointVector(#[from] kinematic_sim::JointVectorError),
     /// The initial base pose is not finite.
     #[error("initial base pose is not finite")]
     NonFiniteBase,
@@ -74,30 +57,4 @@ pub enum MujocoError {
         /// Simulated time of the failure.
         time: f64,
     },
-}
-
-impl From<kinematic_sim::JointVectorError> for MujocoError {
-    fn from(error: kinematic_sim::JointVectorError) -> Self {
-        use kinematic_sim::JointVectorError;
-        match error {
-            JointVectorError::Length {
-                field,
-                expected,
-                actual,
-            } => MujocoError::CommandLength {
-                field,
-                expected,
-                actual,
-            },
-            JointVectorError::NonFinite {
-                field,
-                index,
-                joint,
-            } => MujocoError::NonFiniteCommand {
-                field,
-                index,
-                joint,
-            },
-        }
-    }
 }
