@@ -6,29 +6,22 @@ use kinematics::robot::EndEffector;
 use nalgebra::Isometry3;
 use stance::Gait;
 
-use super::status::{BalanceStatus, ControllerState, Phase};
+use super::status::{ControllerState, ControllerStatus};
 use super::{Controller, pose_array};
 
 /// What the controller estimated and aimed at in its last tick (world frame; poses as
-/// `[x, y, z, qx, qy, qz, qw]`, end-effectors in `EndEffector` order).
+/// `[x, y, z, qx, qy, qz, qw]`, end-effectors in `EndEffector` order): its status and what the
+/// status leaves out.
 #[derive(Clone, Copy, Debug)]
 pub struct ControllerTelemetry {
-    /// Top-level state.
-    pub state: ControllerState,
-    /// Phase of the transition.
-    pub phase: Phase,
-    /// Index of the stance being moved towards.
-    pub stance_index: u32,
-    /// Stances in the sequence.
-    pub stance_count: u32,
+    /// The status after the tick (state, phase, progress, CoM, contacts, balance readings).
+    pub status: ControllerStatus,
+    /// The gait walked (the balance readings of the status are the dynamic gait's).
+    pub gait: Gait,
     /// Estimated floating-base pose.
     pub base: [f64; 7],
-    /// Estimated centre of mass (m).
-    pub com: [f64; 3],
     /// Estimated end-effector frame poses.
     pub end_effectors: [[f64; 7]; 4],
-    /// End-effectors in the contact set.
-    pub contacts: [bool; 4],
     /// Each end-effector's target: its anchor while in contact, else its pose task's set-point,
     /// `None` without either.
     pub targets: [Option<[f64; 7]>; 4],
@@ -36,8 +29,6 @@ pub struct ControllerTelemetry {
     pub com_target: Option<[f64; 2]>,
     /// Support polygon of the feet in contact (the polygon the CoM constraint uses).
     pub support: SupportPolygon,
-    /// ZMP and DCM of the dynamic gait (`None` for the static gait).
-    pub balance: Option<BalanceStatus>,
 }
 
 impl Controller {
@@ -56,18 +47,13 @@ impl Controller {
         }
         let executing = status.state == ControllerState::Executing;
         ControllerTelemetry {
-            state: status.state,
-            phase: status.phase,
-            stance_index: status.stance_index,
-            stance_count: status.stance_count,
+            status: *status,
+            gait: self.machine.gait(),
             base: pose_array(&self.configuration.base),
-            com: status.com,
             end_effectors: self.poses.map(|pose| pose_array(&pose)),
-            contacts: targets.contacts,
             targets: target_poses,
             com_target: executing.then(|| [targets.com.x, targets.com.y]),
             support: self.support_polygon(&targets.contacts, &targets.anchors),
-            balance: (self.machine.gait() == Gait::Dynamic).then_some(status.balance),
         }
     }
 

@@ -3,24 +3,26 @@
 //! bookkeeping). Allocation-free: it runs on the control thread, after the tick's command was sent.
 
 use shm_types::{Code, DaemonState, Flag, SUPPORT_VERTICES, Telemetry, WalkPhase};
+use stance::Gait;
 
-use crate::controller::{ControllerTelemetry, Phase};
+use crate::controller::{BalanceStatus, ControllerTelemetry, Phase};
 
 /// Writes the daemon's `state` and what the `controller` estimated and aimed at into `out`:
 /// every field but the loop's bookkeeping (`seq` to `deadline_misses`, which the loop writes), so
 /// a reused buffer keeps nothing stale.
 pub(super) fn fill(out: &mut Telemetry, state: DaemonState, controller: &ControllerTelemetry) {
+    let status = &controller.status;
     out.state = Code::new(state);
-    out.phase = Code::new(wire_phase(controller.phase));
-    out.stance_index = controller.stance_index;
-    out.stance_count = controller.stance_count;
+    out.phase = Code::new(wire_phase(status.phase));
+    out.stance_index = status.stance_index;
+    out.stance_count = status.stance_count;
     out.base = controller.base;
-    out.com = controller.com;
+    out.com = status.com;
     out.end_effectors = controller.end_effectors;
     for (i, target) in controller.targets.iter().enumerate() {
         out.target_set[i] = Flag::new(target.is_some());
         out.targets[i] = target.unwrap_or(controller.end_effectors[i]);
-        out.contacts[i] = Flag::new(controller.contacts[i]);
+        out.contacts[i] = Flag::new(status.contacts[i]);
     }
     out.com_target_set = Flag::new(controller.com_target.is_some());
     out.com_target = controller.com_target.unwrap_or([0.0; 2]);
@@ -29,8 +31,13 @@ pub(super) fn fill(out: &mut Telemetry, state: DaemonState, controller: &Control
     out.support[..count].copy_from_slice(&vertices[..count]);
     out.support[count..].fill([0.0; 2]);
     out.support_count = count as u32;
-    let balance = controller.balance.unwrap_or_default();
-    out.dynamics_valid = Flag::new(controller.balance.is_some());
+    let dynamic = controller.gait == Gait::Dynamic;
+    let balance = if dynamic {
+        status.balance
+    } else {
+        BalanceStatus::default()
+    };
+    out.dynamics_valid = Flag::new(dynamic);
     out.zmp_reference = balance.zmp_reference;
     out.zmp_measured = balance.zmp_measured;
     out.dcm_reference = balance.dcm_reference;
