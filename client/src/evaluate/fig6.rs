@@ -43,13 +43,45 @@ type PointOf = fn(&Points) -> Vector3<f64>;
 /// A panel's area.
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
-/// One plotted line: its points, dashed or not, colour and legend label.
+/// One plotted line: its points and its style.
 struct Line {
     points: Vec<(f64, f64)>,
+    style: Style,
+}
+
+/// How a line is drawn, and its legend entry.
+#[derive(Clone, Copy)]
+struct Style {
+    label: &'static str,
     dashed: bool,
     colour: RGBColor,
-    label: &'static str,
 }
+
+impl Style {
+    const fn dashed(label: &'static str, colour: RGBColor) -> Self {
+        Self {
+            label,
+            dashed: true,
+            colour,
+        }
+    }
+
+    const fn solid(label: &'static str, colour: RGBColor) -> Self {
+        Self {
+            label,
+            dashed: false,
+            colour,
+        }
+    }
+}
+
+const TARGET: Style = Style::dashed("target", RED);
+const CONTROLLER: Style = Style::solid("controller", BLUE);
+const SIMULATOR: Style = Style::dashed("simulator", GREEN);
+const ZMP_REFERENCE: Style = Style::dashed("ZMP reference", RED);
+const ZMP_MEASURED: Style = Style::solid("ZMP measured", BLUE);
+const DCM_REFERENCE: Style = Style::dashed("DCM reference", RGBColor(230, 140, 0));
+const DCM_MEASURED: Style = Style::solid("DCM measured", MAGENTA);
 
 fn draw(file: &Path, title: &str, trace: &[TraceSample], balance: &[BalanceSample]) -> DrawResult {
     let rows = if balance.is_empty() { 3 } else { 4 };
@@ -74,25 +106,11 @@ fn draw(file: &Path, title: &str, trace: &[TraceSample], balance: &[BalanceSampl
                     .collect()
             };
             let lines = [
-                Line {
-                    points: line(&|s| Some(value(&s.target))),
-                    dashed: true,
-                    colour: RED,
-                    label: "target",
-                },
-                Line {
-                    points: line(&|s| Some(value(&s.controller))),
-                    dashed: false,
-                    colour: BLUE,
-                    label: "controller",
-                },
-                Line {
-                    points: line(&|s| s.sim.as_ref().map(value)),
-                    dashed: true,
-                    colour: GREEN,
-                    label: "simulator",
-                },
-            ];
+                (TARGET, line(&|s| Some(value(&s.target)))),
+                (CONTROLLER, line(&|s| Some(value(&s.controller)))),
+                (SIMULATOR, line(&|s| s.sim.as_ref().map(value))),
+            ]
+            .map(|(style, points)| Line { points, style });
             let caption = format!("{name} {}", ["x", "y", "z"][axis]);
             panel(area, &caption, end, &lines, r == 0 && axis == 0)?;
         }
@@ -106,33 +124,13 @@ fn draw(file: &Path, title: &str, trace: &[TraceSample], balance: &[BalanceSampl
                     .filter(|(_, v)| v.is_finite())
                     .collect()
             };
-            let orange = RGBColor(230, 140, 0);
             let lines = [
-                Line {
-                    points: line(|s| s.zmp_reference),
-                    dashed: true,
-                    colour: RED,
-                    label: "ZMP reference",
-                },
-                Line {
-                    points: line(|s| s.zmp_measured),
-                    dashed: false,
-                    colour: BLUE,
-                    label: "ZMP measured",
-                },
-                Line {
-                    points: line(|s| s.dcm_reference),
-                    dashed: true,
-                    colour: orange,
-                    label: "DCM reference",
-                },
-                Line {
-                    points: line(|s| s.dcm_measured),
-                    dashed: false,
-                    colour: MAGENTA,
-                    label: "DCM measured",
-                },
-            ];
+                (ZMP_REFERENCE, line(|s| s.zmp_reference)),
+                (ZMP_MEASURED, line(|s| s.zmp_measured)),
+                (DCM_REFERENCE, line(|s| s.dcm_reference)),
+                (DCM_MEASURED, line(|s| s.dcm_measured)),
+            ]
+            .map(|(style, points)| Line { points, style });
             let caption = format!("ZMP and DCM {}", ["x", "y"][axis]);
             panel(area, &caption, end, &lines, axis == 0)?;
         }
@@ -164,15 +162,15 @@ fn panel(area: &Area, caption: &str, end: f64, lines: &[Line], legend: bool) -> 
         .light_line_style(WHITE)
         .draw()?;
     for line in lines.iter().filter(|line| !line.points.is_empty()) {
-        let colour = line.colour;
+        let colour = line.style.colour;
         let style = colour.stroke_width(2);
-        let drawn = if line.dashed {
+        let drawn = if line.style.dashed {
             chart.draw_series(DashedLineSeries::new(line.points.clone(), 6, 4, style))?
         } else {
             chart.draw_series(LineSeries::new(line.points.clone(), style))?
         };
         drawn
-            .label(line.label)
+            .label(line.style.label)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour));
     }
     if legend {

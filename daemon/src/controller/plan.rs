@@ -84,19 +84,23 @@ impl TransitionPlan {
 mod tests {
     use super::*;
 
-    fn phases(plan: &TransitionPlan) -> Vec<Phase> {
-        plan.steps().iter().map(|s| s.phase).collect()
+    /// Contact sets (left foot, right foot, left hand, right hand).
+    const BOTH_FEET: [bool; 4] = [true, true, false, false];
+    const LEFT_FOOT: [bool; 4] = [true, false, false, false];
+    const RIGHT_FOOT_LEFT_HAND: [bool; 4] = [false, true, true, false];
+
+    /// The plan from `live` to `next` (the last stance if `is_last`) and its phases in order.
+    fn plan(live: [bool; 4], next: [bool; 4], is_last: bool) -> (TransitionPlan, Vec<Phase>) {
+        let plan = TransitionPlan::new(live, next, is_last);
+        let phases = plan.steps().iter().map(|s| s.phase).collect();
+        (plan, phases)
     }
 
     #[test]
     fn double_to_single_support_releases_the_foot_after_shifting_the_com() {
-        let plan = TransitionPlan::new(
-            [true, true, false, false],
-            [true, false, false, false],
-            false,
-        );
+        let (plan, phases) = plan(BOTH_FEET, LEFT_FOOT, false);
         assert_eq!(
-            phases(&plan),
+            phases,
             [Phase::ShiftCom, Phase::Unload, Phase::Lift, Phase::Swing]
         );
         assert!(
@@ -108,13 +112,9 @@ mod tests {
 
     #[test]
     fn contacts_are_added_before_any_is_released() {
-        let plan = TransitionPlan::new(
-            [true, false, false, false],
-            [false, true, true, false],
-            true,
-        );
+        let (_, phases) = plan(LEFT_FOOT, RIGHT_FOOT_LEFT_HAND, true);
         assert_eq!(
-            phases(&plan),
+            phases,
             [
                 Phase::Swing,
                 Phase::Lower,
