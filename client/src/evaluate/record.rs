@@ -113,10 +113,10 @@ pub struct GroupSummary {
 
 /// `items` split into groups of one affordance set and distance (in the order the groups first
 /// appear), each with its summary; `record` picks an item's [`WalkRecord`].
-pub fn group_by_cell<'a, T>(
-    items: &'a [T],
+pub fn group_by_cell<T>(
+    items: &[T],
     record: impl Fn(&T) -> &WalkRecord,
-) -> Vec<(GroupSummary, Vec<&'a T>)> {
+) -> Vec<(GroupSummary, Vec<&T>)> {
     let mut cells: Vec<(AffordanceSet, f64)> = Vec::new();
     for item in items {
         let r = record(item);

@@ -126,6 +126,25 @@ impl PointTrajectory {
     }
 }
 
+/// Test support: asserts that at time `t` the velocity `sample` gives (linear, angular) is the
+/// central finite difference of its poses.
+#[cfg(test)]
+pub(crate) fn assert_velocity_is_derivative(
+    sample: impl Fn(f64) -> (Isometry3<f64>, [f64; 6]),
+    t: f64,
+) {
+    let h = 1e-6;
+    let (a, _) = sample(t - h);
+    let (b, _) = sample(t + h);
+    let (_, v) = sample(t);
+    let linear = (b.translation.vector - a.translation.vector) / (2.0 * h);
+    let angular = (b.rotation * a.rotation.inverse()).scaled_axis() / (2.0 * h);
+    for k in 0..3 {
+        assert!((linear[k] - v[k]).abs() < 1e-6, "t {t} linear {k}");
+        assert!((angular[k] - v[3 + k]).abs() < 1e-6, "t {t} angular {k}");
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -145,24 +164,5 @@ mod tests {
         assert!(p1.rotation.angle_to(&goal.rotation) < 1e-12);
         assert!(v0.iter().chain(&v1).all(|v| v.abs() < 1e-12));
         assert_velocity_is_derivative(|t| trajectory.sample(t), 0.6);
-    }
-}
-
-/// Test support: asserts that at time `t` the velocity `sample` gives (linear, angular) is the
-/// central finite difference of its poses.
-#[cfg(test)]
-pub(crate) fn assert_velocity_is_derivative(
-    sample: impl Fn(f64) -> (Isometry3<f64>, [f64; 6]),
-    t: f64,
-) {
-    let h = 1e-6;
-    let (a, _) = sample(t - h);
-    let (b, _) = sample(t + h);
-    let (_, v) = sample(t);
-    let linear = (b.translation.vector - a.translation.vector) / (2.0 * h);
-    let angular = (b.rotation * a.rotation.inverse()).scaled_axis() / (2.0 * h);
-    for k in 0..3 {
-        assert!((linear[k] - v[k]).abs() < 1e-6, "t {t} linear {k}");
-        assert!((angular[k] - v[3 + k]).abs() < 1e-6, "t {t} angular {k}");
     }
 }
