@@ -93,6 +93,8 @@ pub struct DemoArgs {
 /// What the demo measured: the watched walk, its gait and the plot.
 pub struct DemoOutcome {
     walk: WatchedWalk,
+    /// A status asked for after the walk, with the complete tick statistics.
+    status: DaemonStatus,
     gait: Gait,
     plot: Option<PathBuf>,
 }
@@ -100,7 +102,7 @@ pub struct DemoOutcome {
 impl DemoOutcome {
     /// The daemon's status after the walk, with its complete tick statistics.
     pub fn status(&self) -> &DaemonStatus {
-        &self.walk.settled
+        &self.status
     }
 
     /// Forward distance the feet midpoint covered, by the controller's estimate (m).
@@ -268,6 +270,8 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     if let Some(progress) = &progress {
         progress.finish();
     }
+    // A status after the walk's last one carries the complete tick statistics.
+    let status = client.status().unwrap_or(walk.last);
     drop(client);
     let plot = match &args.plots {
         Some(dir) => {
@@ -289,7 +293,12 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     if !problems.is_empty() {
         bail!("shutting down: {}", problems.join("; "));
     }
-    Ok(DemoOutcome { walk, gait, plot })
+    Ok(DemoOutcome {
+        walk,
+        status,
+        gait,
+        plot,
+    })
 }
 
 /// `walkctl demo`: runs the demo and prints the outcome; fails unless the walk is done.

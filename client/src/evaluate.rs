@@ -36,9 +36,9 @@ use kinematics::ConfigFile;
 use kinematics::ground::sequence_alignment;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
-use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use shm_types::process::Physics;
-use shm_types::{ClockMode, DaemonState, DaemonStatus, SimTruth};
+use shm_types::{ClockMode, DaemonState, SimTruth};
 use stance::poses::FEET;
 use stance::{AffordanceSet, Gait, PostProcessedSequence, WalkRequest};
 
@@ -172,14 +172,6 @@ pub fn align_targets(
             right_foot: map(target.right_foot).coords,
         };
     }
-}
-
-/// The pose a status carries as `[x, y, z, qx, qy, qz, qw]`.
-pub(crate) fn pose_of(pose: &[f64; 7]) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::new(pose[0], pose[1], pose[2]),
-        UnitQuaternion::from_quaternion(Quaternion::new(pose[6], pose[3], pose[4], pose[5])),
-    )
 }
 
 /// One sample of a Fig. 6 trace.
@@ -426,43 +418,6 @@ fn run_once(
         trace: walk.trace,
         balance: walk.balance,
     })
-}
-
-pub(crate) fn sample(
-    status: &DaemonStatus,
-    start: &DaemonStatus,
-    targets: &[Points],
-) -> TraceSample {
-    let index = (status.stance_index as usize).min(targets.len() - 1);
-    TraceSample {
-        t: (status.ticks.saturating_sub(start.ticks)) as f64 / status.rate_hz,
-        stance_index: status.stance_index,
-        target: targets[index],
-        controller: Points::from_status(&status.com, &status.left_foot, &status.right_foot),
-        sim: None,
-    }
-}
-
-/// Puts the simulator's state into every trace sample whose status (written at `status_times`)
-/// pairs with one; returns the largest controller-vs-simulator distance of the CoM or a sole
-/// and the number of paired samples, or `None` when none paired.
-pub(crate) fn pair_with_truth(
-    trace: &mut [TraceSample],
-    status_times: &[u64],
-    states: &[SimTruth],
-) -> Option<(f64, usize)> {
-    let mut drift: Option<(f64, usize)> = None;
-    for (sample, &time) in trace.iter_mut().zip(status_times) {
-        let Some(state) = truth::state_at(states, time) else {
-            continue;
-        };
-        let sim = Points::from_truth(state);
-        let (com, feet) = sample.controller.distances(&sim);
-        let (largest, samples) = drift.unwrap_or((0.0, 0));
-        drift = Some((largest.max(com).max(feet), samples + 1));
-        sample.sim = Some(sim);
-    }
-    drift
 }
 
 fn row(result: &RunResult) -> String {

@@ -8,12 +8,13 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use kinematics::robot::Robot;
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 use shm_types::{DaemonStatus, SimTruth};
 use stance::PostProcessedSequence;
 
 use super::balance::BalanceRecorder;
 use super::truth::{TruthRecorder, Verdict, state_at};
-use super::{BalanceSample, Points, TraceSample, align_targets, pair_with_truth, pose_of, sample};
+use super::{BalanceSample, Points, TraceSample, align_targets};
 use crate::daemon_client::DaemonClient;
 use crate::observe::{Recorder, RecorderOutcome};
 
@@ -35,9 +36,6 @@ pub(crate) struct WatchedWalk {
     pub start: DaemonStatus,
     /// The walk's last status.
     pub last: DaemonStatus,
-    /// A status asked for after the end, with the complete tick statistics (`last` if none
-    /// came).
-    pub settled: DaemonStatus,
     /// Wall time from submission to the end (s).
     pub wall_s: f64,
     /// Simulated time from submission to the walk's last status (s).
@@ -98,7 +96,6 @@ pub(crate) fn watch_walk(
         }
     })?;
     let wall_s = wall.elapsed().as_secs_f64();
-    let settled = client.status().unwrap_or(last);
     let recording = observer.map(Recorder::finish).transpose()?;
     let states = recorder.finish()?;
     let balance = match balance {
@@ -121,7 +118,6 @@ pub(crate) fn watch_walk(
         verdict: Verdict::of(&states, submitted_ns),
         start,
         last,
-        settled,
         wall_s,
         submitted_ns,
         states,
@@ -131,4 +127,46 @@ pub(crate) fn watch_walk(
         balance,
         recording,
     })
+}
+
+/// The pose a status carries as `[x, y, z, qx, qy, qz, qw]`.
+fn pose_of(pose: &[f64; 7]) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(pose[0], pose[1], pose[2]),
+        UnitQuaternion::from_quaternion(Quaternion::new(pose[6], pose[3], pose[4], pose[5])),
+    )
+}
+
+/// The trace sample of `status`, timed from `start`, against the target of its stance.
+fn sample(status: &DaemonStatus, start: &DaemonStatus, targets: &[Points]) -> TraceSample {
+    let index = (status.stance_index as usize).min(targets.len() - 1);
+    TraceSample {
+        t: (status.ticks.saturating_sub(start.ticks)) as f64 / status.rate_hz,
+        stance_index: status.stance_index,
+        target: targets[index],
+        controller: Points::from_status(&status.com, &status.left_foot, &status.right_foot),
+        sim: None,
+    }
+}
+
+/// Puts the simulator's state into every trace sample whose status (written at `status_times`)
+/// pairs with one; returns the largest controller-vs-simulator distance of the CoM or a sole
+/// and the number of paired samples, or `None` when none paired.
+fn pair_with_truth(
+    trace: &mut [TraceSample],
+    status_times: &[u64],
+    states: &[SimTruth],
+) -> Option<(f64, usize)> {
+    let mut drift: Option<(f64, usize)> = None;
+    for (sample, &time) in trace.iter_mut().zip(status_times) {
+        let Some(state) = state_at(states, time) else {
+            continue;
+        };
+        let sim = Points::from_truth(state);
+        let (com, feet) = sample.controller.distances(&sim);
+        let (largest, samples) = drift.unwrap_or((0.0, 0));
+        drift = Some((largest.max(com).max(feet), samples + 1));
+        sample.sim = Some(sim);
+    }
+    drift
 }
