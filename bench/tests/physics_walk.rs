@@ -293,3 +293,167 @@ mod walks {
         check_learned("armar4");
     }
 }
+
+/// A fault in single support must not become a fall (docs/safety.md, "Controlled stop"): a
+/// dynamic walk under MuJoCo, faulted half way through its fourth single support by a NaN joint
+/// angle in one measurement or by a hold request, ends standing on both feet, not fallen, holding
+/// (in fault after the NaN), within 2 s of the fault, and stays standing for a second more. JVRC-1
+/// and ARMAR-4. Holding the last command in single support instead, the robot fell: 8 of 8 faults
+/// in the hostile trials of issue 20.
+#[cfg(feature = "mujoco")]
+mod stops {
+    use std::sync::Arc;
+
+    use daemon::controller::{
+        Controller, ControllerConfig, ControllerState, Gait, GaitConfig, Measurement, Phase,
+        SolverKind,
+    };
+    use kinematic_sim::Simulator;
+    use kinematics::robot::{EndEffector, Robot};
+    use sim_adapter::mujoco::{MujocoOptions, MujocoSim};
+    use stance::{PostProcessParams, WalkRequest};
+    use walk_bench::ClosedLoop;
+
+    const RATE_HZ: f64 = 500.0;
+    /// A stop must be over this long after the fault (s).
+    const STOP_WITHIN_S: f64 = 2.0;
+
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    enum Fault {
+        NanJointAngle,
+        Hold,
+    }
+
+    /// One tick of `closed`; with `nan`, the measured angle of joint 0 is NaN.
+    fn tick(closed: &mut ClosedLoop<MujocoSim>, nan: bool) {
+        let m = closed.sim.measurement();
+        let mut q = m.q.clone();
+        if nan {
+            q[0] = f64::NAN;
+        }
+        let measurement = Measurement {
+            q: q.as_slice(),
+            qd: m.qd.as_slice(),
+            wrenches: &m.wrenches,
+            imu_orientation: Some(m.base_orientation),
+        };
+        let dt = closed.dt();
+        assert!(
+            closed
+                .controller
+                .tick(&measurement, dt, &mut closed.command),
+            "a command after every tick"
+        );
+        let command = &closed.command;
+        assert!(
+            command
+                .q_des
+                .iter()
+                .chain(&command.qd_des)
+                .all(|v| v.is_finite())
+        );
+        closed
+            .sim
+            .step(command.q_des.as_slice(), command.qd_des.as_slice(), dt)
+            .expect("MuJoCo steps");
+    }
+
+    /// `robot` walks 2 m dynamically and meets `fault` half way through its fourth single
+    /// support; returns the time from the fault to the end of the stop (s).
+    fn stop(robot_name: &str, fault: Fault) -> f64 {
+        let config_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../configs")
+            .join(format!("{robot_name}.toml"));
+        let robot = Arc::new(Robot::load(&config_path, None).expect("vendored robot"));
+        let file = kinematics::ConfigFile::load(&config_path).expect("config");
+        let config = ControllerConfig::from_config_file(&config_path).expect("controller");
+        let gaits = GaitConfig::from_config_file(&config_path).expect("gait");
+        let single_support_s = gaits.dynamic.expect("a dynamic gait").single_support_s;
+        let params = PostProcessParams::from_config_for(&file, Gait::Dynamic).expect("params");
+        let sequence =
+            stance::synthetic_walk(&robot, &params, &WalkRequest::feet(2.0, 0)).expect("a walk");
+        let prepared = Controller::prepare_gait(&robot, &config, &gaits, &sequence, Gait::Dynamic)
+            .expect("accepted");
+        let controller = Controller::new(robot.clone(), config, SolverKind::Dense).unwrap();
+        let sim = MujocoSim::new(
+            robot.clone(),
+            &robot.urdf,
+            &robot.standing,
+            MujocoOptions::default(),
+        )
+        .expect("MuJoCo model");
+        let mut closed = ClosedLoop::new(controller, sim, RATE_HZ);
+        assert!(closed.controller.start(Box::new(prepared)).is_ok());
+        let name = format!("{robot_name} {fault:?}");
+        // Into the fourth single support, then half way through it.
+        let mut single_supports = 0;
+        let mut previous = Phase::None;
+        while single_supports < 4 {
+            tick(&mut closed, false);
+            let phase = closed.controller.status().phase;
+            if phase == Phase::SingleSupport && previous != Phase::SingleSupport {
+                single_supports += 1;
+            }
+            previous = phase;
+            assert_eq!(
+                closed.controller.status().state,
+                ControllerState::Executing,
+                "{name}: before the fault"
+            );
+        }
+        for _ in 0..(0.5 * single_support_s * RATE_HZ) as usize {
+            tick(&mut closed, false);
+        }
+        assert_eq!(closed.controller.status().phase, Phase::SingleSupport);
+        let faulted_at = closed.sim.time();
+        match fault {
+            Fault::NanJointAngle => tick(&mut closed, true),
+            Fault::Hold => {
+                closed.controller.hold();
+                tick(&mut closed, false);
+            }
+        }
+        let held = |state: ControllerState| {
+            matches!(state, ControllerState::Fault | ControllerState::Holding)
+        };
+        let limit = (4.0 * RATE_HZ) as usize;
+        for _ in 0..limit {
+            if held(closed.controller.status().state) {
+                break;
+            }
+            tick(&mut closed, false);
+            assert!(!closed.sim.has_fallen(), "{name}: fell while stopping");
+        }
+        let stop_s = closed.sim.time() - faulted_at;
+        for _ in 0..RATE_HZ as usize {
+            tick(&mut closed, false);
+        }
+        let status = closed.controller.status();
+        let expected = match fault {
+            Fault::NanJointAngle => ControllerState::Fault,
+            Fault::Hold => ControllerState::Holding,
+        };
+        assert_eq!(status.state, expected, "{name}: {:?}", status.fault);
+        assert!(!closed.sim.has_fallen(), "{name}: fell after the stop");
+        let contacts = closed.sim.measurement().contacts;
+        assert!(
+            contacts[EndEffector::LeftFoot as usize] && contacts[EndEffector::RightFoot as usize],
+            "{name}: not on both feet at the end: {contacts:?}"
+        );
+        eprintln!("{name}: stopped in {stop_s:.2} s");
+        assert!(stop_s <= STOP_WITHIN_S, "{name}: stopped in {stop_s:.2} s");
+        stop_s
+    }
+
+    #[test]
+    fn jvrc1_stops_on_both_feet_after_a_fault_in_single_support() {
+        stop("jvrc1", Fault::NanJointAngle);
+        stop("jvrc1", Fault::Hold);
+    }
+
+    #[test]
+    fn armar4_stops_on_both_feet_after_a_fault_in_single_support() {
+        stop("armar4", Fault::NanJointAngle);
+        stop("armar4", Fault::Hold);
+    }
+}

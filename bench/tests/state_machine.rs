@@ -4,7 +4,8 @@
 mod walk_support;
 
 use daemon::controller::{
-    CommandMode, ControllerState, FaultCode, MeasurementFault, Phase, StartRefusal,
+    CommandMode, ControllerConfig, ControllerState, FaultCode, MeasurementFault, Phase,
+    StartRefusal,
 };
 use kinematic_sim::Simulator;
 use kinematics::robot::EndEffector;
@@ -15,7 +16,11 @@ const RATE_HZ: f64 = 200.0;
 const MAX_TICKS: usize = 20_000;
 
 fn started(robot: &str, hand: bool) -> Harness {
-    let mut h = Harness::new(robot, RATE_HZ);
+    start(Harness::new(robot, RATE_HZ), hand)
+}
+
+/// `h` walking the two-step synthetic walk.
+fn start(mut h: Harness, hand: bool) -> Harness {
     let sequence = walk_support::synthetic_walk(&h.robot, 2, 0.08, hand);
     h.start(&sequence);
     h
@@ -51,9 +56,16 @@ fn walk_to_done(h: &mut Harness, mut observe: impl FnMut(&Harness)) {
     panic!("the walk did not end in {MAX_TICKS} ticks");
 }
 
+/// The landing foot's sensor is dead. The kinematic simulator then puts most of the weight on
+/// that foot, so with the default `support_force_min_fraction` the feet read as unloaded first
+/// (the next test); here that check is relaxed to reach the Lower timeout.
 #[test]
 fn touchdown_never_confirmed_is_a_lower_timeout_fault() {
-    let mut h = started("jvrc1", false);
+    let config = ControllerConfig {
+        support_force_min_fraction: 0.01,
+        ..walk_support::controller_config("jvrc1")
+    };
+    let mut h = start(Harness::with_config("jvrc1", config, RATE_HZ), false);
     run_until(&mut h, Phase::Lower);
     // The force-torque sensor of the landing (right) foot reads nothing from now on.
     let mut ticks = 0;
@@ -77,6 +89,45 @@ fn touchdown_never_confirmed_is_a_lower_timeout_fault() {
             "a fault holds the last safe command"
         );
     }
+    h.assert_safe();
+}
+
+/// The same dead sensor with the default limits: once the feet have read less than
+/// `support_force_min_fraction` of the weight for `unloaded_max_s`, the static gait faults and
+/// holds, naming the load.
+#[test]
+fn feet_that_stay_unloaded_while_walking_fault_and_hold() {
+    let mut h = started("jvrc1", false);
+    let config = walk_support::controller_config("jvrc1");
+    run_until(&mut h, Phase::Lower);
+    let mut unloaded_ticks = 0;
+    while h.closed.controller.status().state == ControllerState::Executing {
+        h.tick_with(|w| w[EndEffector::RightFoot as usize] = [0.0; 6]);
+        // What the controller reads: the left foot's force only.
+        let load = h.closed.sim.measurement().wrenches[EndEffector::LeftFoot as usize][2];
+        let weight = h.robot.model.total_mass() * kinematics::ground::GRAVITY;
+        if load < config.support_force_min_fraction * weight {
+            unloaded_ticks += 1;
+        }
+        assert!(unloaded_ticks < 1000, "never faulted");
+    }
+    let status = *h.closed.controller.status();
+    assert_eq!(status.state, ControllerState::Fault);
+    assert!(
+        matches!(
+            status.fault,
+            FaultCode::InvalidMeasurement(MeasurementFault::Unloaded(_))
+        ),
+        "{:?}",
+        status.fault
+    );
+    // Faulted after unloaded_max_s of unloaded readings, not before.
+    let unloaded_s = unloaded_ticks as f64 / RATE_HZ;
+    assert!(
+        unloaded_s > config.unloaded_max_s && unloaded_s <= config.unloaded_max_s + 2.0 / RATE_HZ,
+        "faulted after {unloaded_s} s unloaded"
+    );
+    assert_eq!(h.closed.command.mode, CommandMode::Hold);
     h.assert_safe();
 }
 

@@ -6,7 +6,7 @@ use kinematic_sim::Simulator;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use daemon::controller::{ControllerState, Measurement};
+use daemon::controller::{ControllerState, Measurement, Phase};
 
 struct Counting;
 
@@ -42,41 +42,89 @@ fn controller_tick_does_not_allocate() {
         let mut h = walk_support::Harness::new(robot, 200.0);
         let sequence = walk_support::synthetic_walk(&h.robot, 2, 0.08, true);
         h.start(&sequence);
-        walk_counting_allocations(robot, h);
+        let end = walk_counting_allocations(robot, h, |_, _| {});
+        assert_eq!(end, ControllerState::Done, "{robot}");
     }
     // The dynamic gait's tick (walking pattern, stabilizer, compliance, swing) allocates nothing
-    // either: its plan is built when the sequence is prepared. (ARMAR-4 has no dynamic gait.)
-    let mut h = walk_support::Harness::dynamic("jvrc1", 500.0);
-    let sequence = walk_support::synthetic_walk(&h.robot, 4, 0.1, true);
-    let mut gaits = walk_support::kinematic_gait_config("jvrc1");
-    // Foot damping runs its code path here too (it has no effect worth having on a kinematic
-    // robot, but it walks).
-    gaits.dynamic.as_mut().unwrap().stabilizer.foot_damping = true;
-    h.start_dynamic(&sequence, &gaits);
-    walk_counting_allocations("jvrc1", h);
+    // either: its plan is built when the sequence is prepared. Nor does a controlled stop, with
+    // a tick on the last valid state: a NaN 0.1 s into the first single support, and a hold at
+    // the same moment.
+    let dynamic = || {
+        let mut h = walk_support::Harness::dynamic("jvrc1", 500.0);
+        let sequence = walk_support::synthetic_walk(&h.robot, 4, 0.1, true);
+        let mut gaits = walk_support::kinematic_gait_config("jvrc1");
+        // Foot damping runs its code path here too (it has no effect worth having on a
+        // kinematic robot, but it walks).
+        gaits.dynamic.as_mut().unwrap().stabilizer.foot_damping = true;
+        h.start_dynamic(&sequence, &gaits);
+        h
+    };
+    let mut holding = dynamic();
+    let mut fault_tick = 50;
+    while holding.closed.controller.status().phase != Phase::SingleSupport {
+        holding.tick();
+        fault_tick += 1;
+    }
+    for _ in 0..50 {
+        holding.tick();
+    }
+    let end = walk_counting_allocations("jvrc1", dynamic(), |_, _| {});
+    assert_eq!(end, ControllerState::Done);
+    let end = walk_counting_allocations("jvrc1", dynamic(), |tick, q| {
+        if tick == fault_tick {
+            q[0] = f64::NAN;
+        }
+    });
+    assert_eq!(end, ControllerState::Fault);
+    assert_eq!(
+        holding.closed.controller.status().phase,
+        Phase::SingleSupport
+    );
+    count_allocations("jvrc1", "hold", || holding.closed.controller.hold());
+    let end = walk_counting_allocations("jvrc1", holding, |_, _| {});
+    assert_eq!(end, ControllerState::Holding);
 }
 
-/// Walks the started sequence of `h` to `done`, counting the allocations inside the ticks.
-fn walk_counting_allocations(robot: &str, mut h: walk_support::Harness) {
-    let mut ticks = 0;
-    let mut allocations = 0;
-    while h.closed.controller.status().state != ControllerState::Done && ticks < 20_000 {
+/// Runs `call` counting its allocations; asserts there were none.
+fn count_allocations(robot: &str, what: &str, call: impl FnOnce()) {
+    ALLOCATIONS.store(0, Ordering::Relaxed);
+    COUNTING.store(true, Ordering::Relaxed);
+    call();
+    COUNTING.store(false, Ordering::Relaxed);
+    let allocations = ALLOCATIONS.load(Ordering::Relaxed);
+    assert_eq!(
+        allocations, 0,
+        "{robot}: {allocations} allocations in {what}"
+    );
+}
+
+/// Ticks the started sequence of `h` until it ends (neither executing nor coming to a
+/// controlled stop), its measured joint angles passed through `tamper` (with the tick's number)
+/// first; asserts that no tick allocates and returns the state it ended in.
+fn walk_counting_allocations(
+    robot: &str,
+    mut h: walk_support::Harness,
+    mut tamper: impl FnMut(usize, &mut [f64]),
+) -> ControllerState {
+    let mut q = vec![0.0; h.robot.model.dof()];
+    for tick in 0..20_000 {
         let m = h.closed.sim.measurement();
+        q.copy_from_slice(m.q.as_slice());
+        tamper(tick, &mut q);
         let measurement = Measurement {
-            q: m.q.as_slice(),
+            q: &q,
             qd: m.qd.as_slice(),
             wrenches: &m.wrenches,
             imu_orientation: Some(m.base_orientation),
         };
-        ALLOCATIONS.store(0, Ordering::Relaxed);
-        COUNTING.store(true, Ordering::Relaxed);
-        let commanded = h
-            .closed
-            .controller
-            .tick(&measurement, h.dt, &mut h.closed.command);
-        COUNTING.store(false, Ordering::Relaxed);
-        allocations += ALLOCATIONS.load(Ordering::Relaxed);
-        assert!(commanded, "{robot}: the simulator's measurements are valid");
+        let mut commanded = false;
+        count_allocations(robot, "a tick", || {
+            commanded = h
+                .closed
+                .controller
+                .tick(&measurement, h.dt, &mut h.closed.command);
+        });
+        assert!(commanded, "{robot}: the controller commands on every tick");
         h.closed
             .sim
             .step(
@@ -85,19 +133,13 @@ fn walk_counting_allocations(robot: &str, mut h: walk_support::Harness) {
                 h.dt,
             )
             .unwrap();
-        ticks += 1;
+        let status = h.closed.controller.status();
+        if !matches!(
+            status.state,
+            ControllerState::Executing | ControllerState::ControlledStop
+        ) {
+            return status.state;
+        }
     }
-    let status = h.closed.controller.status();
-    assert_eq!(
-        status.state,
-        ControllerState::Done,
-        "{robot}: {:?} in {:?} at stance {}",
-        status.fault,
-        status.phase,
-        status.stance_index
-    );
-    assert_eq!(
-        allocations, 0,
-        "{robot}: {allocations} allocations in {ticks} ticks"
-    );
+    panic!("{robot}: the walk did not end in 20 000 ticks");
 }

@@ -131,7 +131,7 @@ impl DaemonClient {
                 .next_status(Duration::from_secs(2))
                 .context("walkd stopped publishing its status")?;
             on_status(&status);
-            let finished = status.sequence_id == id && status.state != DaemonState::Executing;
+            let finished = status.sequence_id == id && !status.walking();
             if finished || status.sequence_id > id || status.state == DaemonState::Stopping {
                 return Ok(status);
             }

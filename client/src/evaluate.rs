@@ -12,6 +12,9 @@
 //!   the simulator's truth of the state that status's tick saw ([`truth::state_at`]);
 //! - final position error: the simulated soles' distance from their final targets.
 //!
+//! `--inject FAULTS` injects each fault into every walk at each `--inject-at` moment of a single
+//! support (walk-sim's fault injection) and judges the stop instead of the walk ([`stop`]).
+//!
 //! `--plots DIR` writes the paper's Fig. 6 per robot (first run of the first distance, feet
 //! only): target vs controller state vs simulator over time for the CoM and both feet
 //! ([`write_fig6`] is shared with the in-process physics walk of the `walk-tests` package).
@@ -20,6 +23,7 @@ pub(crate) mod balance;
 pub mod fig6;
 pub mod filmstrip;
 pub mod record;
+pub mod stop;
 pub(crate) mod truth;
 pub(crate) mod watch;
 
@@ -44,6 +48,7 @@ use stance::{AffordanceSet, Gait, PostProcessedSequence, WalkRequest};
 
 use crate::daemon_client::connect_when_fresh;
 use crate::process::{Launch, executable_dir};
+use stop::{InjectArgs, Injection, StopReport};
 use watch::{WatchOptions, watch_walk};
 
 /// Arguments of `walkctl evaluate`.
@@ -84,6 +89,9 @@ pub struct EvaluateArgs {
     /// `DIR/<robot>-<affordances>-<distance>m-run<run>.mcap`.
     #[arg(long, value_name = "DIR")]
     pub record: Option<PathBuf>,
+    /// Faults to inject into every walk, and when.
+    #[command(flatten)]
+    pub inject: InjectArgs,
 }
 
 /// The CoM and both soles' positions in the world (m).
@@ -214,6 +222,8 @@ pub struct RunResult {
     pub trace: Vec<TraceSample>,
     /// A dynamic walk's ZMP and DCM from walkd's telemetry (empty for the static gait).
     pub balance: Vec<BalanceSample>,
+    /// With an injected fault: how the walk stopped (it decides `record.success`).
+    pub stop: Option<StopReport>,
 }
 
 impl RunResult {
@@ -238,6 +248,17 @@ impl RunResult {
             "gait": self.gait.name(),
             "walked_m": r.walked_m,
             "speed_m_s": r.speed_m_s,
+            "injected": self.stop.map(|stop| serde_json::json!({
+                "fault": stop.injection.fault.name(),
+                "at": stop.injection.moment.name(),
+                "step": stop.injection.step,
+                "delay_s": stop.injection.delay_s,
+                "stop_s": stop.stop_s,
+                "ended": stop.ended.name(),
+                "feet_down": stop.feet_down,
+                "fell": stop.fell,
+                "max_tilt_rad": stop.max_tilt_rad,
+            })),
         })
     }
 }
@@ -253,13 +274,20 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
             Robot::load(&config, args.urdf.as_deref())
                 .with_context(|| format!("robot `{robot}` ({})", config.display()))?,
         );
-        for (i, request) in requests.iter().enumerate() {
+        let injections = args.inject.injections(&ConfigFile::load(&config)?)?;
+        let runs = requests
+            .iter()
+            .flat_map(|request| injections.iter().map(move |injection| (request, injection)));
+        for (i, (request, injection)) in runs.enumerate() {
             let pictured = args.snapshots.as_deref().filter(|_| i == 0);
-            let result =
-                run_once(args, robot, &model, &config, request, pictured).with_context(|| {
+            let result = run_once(args, robot, &model, &config, request, *injection, pictured)
+                .with_context(|| {
                     format!(
-                        "{robot} {} {} m run {}",
-                        request.affordances, request.distance, request.seed
+                        "{robot} {} {} m run {}{}",
+                        request.affordances,
+                        request.distance,
+                        request.seed,
+                        injection.map_or_else(String::new, |i| format!(" ({})", i.label()))
                     )
                 })?;
             if !args.json {
@@ -305,14 +333,15 @@ fn plot_robot(dir: &Path, robot: &str, results: &[RunResult]) -> anyhow::Result<
     write_fig6(&file, &title, &result.trace, &result.balance)
 }
 
-/// One run: own processes on an own prefix, submit, record, stop; with `pictured`, the
-/// snapshots of `--snapshots` go there.
+/// One run: own processes on an own prefix, submit, record, stop; with `injection`, walk-sim
+/// injects that fault; with `pictured`, the snapshots of `--snapshots` go there.
 fn run_once(
     args: &EvaluateArgs,
     robot: &str,
     model: &Arc<Robot>,
     config: &Path,
     request: &WalkRequest,
+    injection: Option<Injection>,
     pictured: Option<&Path>,
 ) -> anyhow::Result<RunResult> {
     let file = ConfigFile::load(config)?;
@@ -342,6 +371,9 @@ fn run_once(
         sim_args.extend(["--snapshots".into(), frames.into()]);
         sim_args.extend(["--snapshot-lookat".into(), lookat.into()]);
     }
+    if let Some(injection) = &injection {
+        sim_args.extend(injection.sim_args());
+    }
     let processes = [
         launch.walkd(&["--no-lock-memory"], &[])?,
         launch.walk_sim(args.physics, &sim_args)?,
@@ -354,7 +386,9 @@ fn run_once(
                 affordances.name()
             ))
         }),
-        balance: gait == Gait::Dynamic,
+        balance: gait == Gait::Dynamic || injection.is_some(),
+        // After a stop, watch a while longer whether the robot stays up.
+        linger: Duration::from_secs(u64::from(injection.is_some())),
         timeout: Duration::from_secs(120 + 60 * sequence.len() as u64),
         on_status: &|_| {},
     };
@@ -394,14 +428,20 @@ fn run_once(
     } else {
         format!("{}: {}", last.state.name(), last.fault)
     };
+    let stop = injection.map(|injection| stop::judge(injection, &walk));
+    let success = stop.map_or(done && verdict.fell_at_s.is_none(), |s| s.success());
+    let outcome = match &stop {
+        Some(stop) => format!("{} ({daemon_outcome})", stop.describe()),
+        None => truth::judged_outcome(verdict.fell_at_s, &daemon_outcome),
+    };
     Ok(RunResult {
         robot: robot.to_owned(),
         record: WalkRecord {
             affordances,
             distance_m: distance,
             seed: request.seed,
-            outcome: truth::judged_outcome(verdict.fell_at_s, &daemon_outcome),
-            success: done && verdict.fell_at_s.is_none(),
+            outcome,
+            success,
             stances: sequence.len(),
             walked_m: verdict.walked_m,
             speed_m_s: verdict.speed_m_s(walk.sim_s),
@@ -417,6 +457,7 @@ fn run_once(
         gait,
         trace: walk.trace,
         balance: walk.balance,
+        stop,
     })
 }
 

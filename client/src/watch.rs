@@ -3,7 +3,7 @@
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use shm_types::{DaemonState, DaemonStatus};
+use shm_types::DaemonStatus;
 
 use crate::daemon_client::{DaemonClient, DaemonTarget, status_text};
 
@@ -65,7 +65,7 @@ pub fn run(args: &WatchArgs) -> anyhow::Result<()> {
     let status = client.status()?;
     let progress = StanceProgress::new();
     progress.update(&status);
-    let last = if status.state == DaemonState::Executing {
+    let last = if status.walking() {
         client.wait_for_sequence(
             status.sequence_id,
             Duration::from_secs(args.timeout_s),

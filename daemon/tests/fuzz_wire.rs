@@ -190,7 +190,7 @@ fn random_samples_never_command_outside_the_limits() {
                 Ok(measurement) => controller.tick(&measurement, 0.002, &mut command),
                 Err(fault) => {
                     refused += 1;
-                    controller.refuse_measurement(fault, &mut command)
+                    controller.refuse_measurement(fault, 0.002, &mut command)
                 }
             };
             let _ = controller.reset();

@@ -54,8 +54,8 @@ pub use telemetry::{SUPPORT_VERTICES, Telemetry, WalkPhase};
 pub use text::FixedText;
 
 /// Version of the wire protocol; part of every message's `#[type_name]`. Version 2: enums and
-/// flags travel as checked integers ([`wire`]).
-pub const PROTOCOL_VERSION: u32 = 2;
+/// flags travel as checked integers ([`wire`]); version 3: the daemon state `controlled_stop`.
+pub const PROTOCOL_VERSION: u32 = 3;
 
 /// Fixed joint capacity of the joint arrays; messages carry the used count explicitly.
 pub const MAX_JOINTS: usize = 64;

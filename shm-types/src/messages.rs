@@ -164,6 +164,10 @@ wire_enum! {
         Fault = 4 => "fault",
         /// Shutting down (the last status before the daemon exits).
         Stopping = 5 => "stopping",
+        /// A dynamic walk ends early under control (a fault, a hold or an abort): the swing foot
+        /// lands and the robot comes to rest on both feet; then `Fault` (a fault caused it,
+        /// `DaemonStatus::fault` says which) or `Holding`.
+        ControlledStop = 6 => "controlled_stop",
     }
 }
 
@@ -338,6 +342,12 @@ impl DaemonStatus {
 }
 
 impl DaemonStatus {
+    /// Whether the robot is still walking its sequence: executing it, or coming to a controlled
+    /// stop (a client waiting for a walk's end waits for both).
+    pub fn walking(&self) -> bool {
+        self.state == DaemonState::Executing || self.state == DaemonState::ControlledStop
+    }
+
     /// Checks the fields a client decodes (state, clock, link, flags); names the first bad one.
     pub fn validate(&self) -> Result<(), DecodeError> {
         self.state.get().map_err(|e| e.in_field("state"))?;

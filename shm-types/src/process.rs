@@ -47,6 +47,47 @@ pub fn termination_requested() -> bool {
 }
 
 wire_enum! {
+    /// The fault `walk-sim --inject` injects to evaluate walkd's controlled stop, named the same by
+    /// `walkctl evaluate --inject` (`sim_adapter::inject`).
+    pub enum InjectedFault {
+        /// One sample with a NaN joint angle.
+        Nan = 0 => "nan",
+        /// One sample with a joint 0.2 rad beyond its upper limit.
+        JointOutOfLimits = 1 => "joint-out-of-limits",
+        /// One sample in which every force-torque sensor reads zero (not a fault walkd can tell
+        /// from a sole bouncing off the ground: the walk goes on).
+        ZeroForce = 2 => "zero-force",
+        /// walkd is asked to hold.
+        Hold = 3 => "hold",
+        /// walkd is asked to abort.
+        Abort = 4 => "abort",
+        /// The foot in the air never reports contact again: its wrench reads zero from then on.
+        WithheldTouchdown = 5 => "withheld-touchdown",
+        /// Every force-torque sensor reads zero for 0.1 s (a sensor dropout).
+        ForceDropout = 6 => "force-dropout",
+    }
+}
+
+impl InjectedFault {
+    /// Every kind, in the order the evaluation tries them.
+    pub const ALL: [InjectedFault; 7] = [
+        Self::Nan,
+        Self::JointOutOfLimits,
+        Self::ZeroForce,
+        Self::ForceDropout,
+        Self::Hold,
+        Self::Abort,
+        Self::WithheldTouchdown,
+    ];
+
+    /// Whether walkd must end the walk for it (all but a single zero-force sample, which
+    /// physics can produce too).
+    pub fn must_stop(self) -> bool {
+        self != Self::ZeroForce
+    }
+}
+
+wire_enum! {
     /// The simulator behind `walk-sim --physics`, named the same by every process that starts it.
     pub enum Physics {
         /// The deterministic kinematic simulator (ideal servos, feet anchored in contact).

@@ -8,8 +8,10 @@
 //!   simulator, `--physics kinematic`, or MuJoCo, `--physics mujoco`).
 //! - [`GroundTruth`], [`PublishTruth`]: a simulated robot's true state on the `sim-truth`
 //!   service, for evaluation (drift of the controller's estimate, fall judgement).
+//! - [`inject`]: fault injection for evaluating the controlled stop (`walk-sim --inject`).
 
 mod adapter_loop;
+pub mod inject;
 mod robot_io;
 mod simulated;
 mod truth;

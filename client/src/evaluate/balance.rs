@@ -1,12 +1,13 @@
 //! The balance of a dynamic walk over the real processes: walkd's per-tick telemetry
 //! (`<prefix>/telemetry`, read by the observer's [`Source`]) kept on a thread of its own, every
-//! [`KEEP_EVERY`]th tick that carries ZMP and DCM, for the balance row of Fig. 6.
+//! [`KEEP_EVERY`]th tick that carries ZMP and DCM, for the balance row of Fig. 6, and every tick
+//! at which the daemon's state changed (to time a controlled stop to the tick).
 
 use std::sync::mpsc::Receiver;
 use std::thread::JoinHandle;
 
 use anyhow::Context;
-use shm_types::Telemetry;
+use shm_types::{DaemonState, Telemetry};
 
 use super::fig6::BalanceSample;
 use crate::observe::source::{Batch, Source};
@@ -14,10 +15,28 @@ use crate::observe::source::{Batch, Source};
 /// One telemetry in this many is kept (at 500 Hz: 100 samples a second).
 pub(crate) const KEEP_EVERY: u64 = 5;
 
+/// A tick at which the daemon's state changed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StateChange {
+    /// The tick.
+    pub tick: u64,
+    /// `timestamp_ns` of the sample the tick answered (pairs with the simulator's truth).
+    pub sample_timestamp_ns: u64,
+    /// The state after the tick.
+    pub state: DaemonState,
+}
+
+/// What the recorder kept.
+#[derive(Default)]
+struct Kept {
+    balance: Vec<Telemetry>,
+    changes: Vec<StateChange>,
+}
+
 /// The ticks and ZMP/DCM of a walk's telemetry, until [`BalanceRecorder::finish`].
 pub(crate) struct BalanceRecorder {
     source: Source,
-    collector: JoinHandle<Vec<Telemetry>>,
+    collector: JoinHandle<Kept>,
 }
 
 impl BalanceRecorder {
@@ -31,18 +50,20 @@ impl BalanceRecorder {
         Ok(Self { source, collector })
     }
 
-    /// Stops recording; the samples from tick `start_tick` on at `rate_hz`, time from there.
+    /// Stops recording; the samples from tick `start_tick` on at `rate_hz`, time from there,
+    /// and the state changes from that tick on.
     pub(crate) fn finish(
         self,
         start_tick: u64,
         rate_hz: f64,
-    ) -> anyhow::Result<Vec<BalanceSample>> {
+    ) -> anyhow::Result<(Vec<BalanceSample>, Vec<StateChange>)> {
         self.source.stop()?;
-        let telemetry = self
+        let kept = self
             .collector
             .join()
             .map_err(|_| anyhow::anyhow!("the balance recorder panicked"))?;
-        Ok(telemetry
+        let balance = kept
+            .balance
             .iter()
             .filter(|t| t.tick >= start_tick)
             .map(|t| BalanceSample {
@@ -52,20 +73,36 @@ impl BalanceRecorder {
                 dcm_reference: t.dcm_reference,
                 dcm_measured: t.dcm_measured,
             })
-            .collect())
+            .collect();
+        let changes = kept
+            .changes
+            .into_iter()
+            .filter(|c| c.tick >= start_tick)
+            .collect();
+        Ok((balance, changes))
     }
 }
 
-/// Keeps every [`KEEP_EVERY`]th telemetry with ZMP and DCM until the batches end.
-fn collect(batches: &Receiver<Batch>) -> Vec<Telemetry> {
-    let mut kept = Vec::new();
+/// Keeps every [`KEEP_EVERY`]th telemetry with ZMP and DCM, and every state change, until the
+/// batches end.
+fn collect(batches: &Receiver<Batch>) -> Kept {
+    let mut kept = Kept::default();
+    let mut state = None;
     for batch in batches {
-        kept.extend(
-            batch
-                .telemetry
-                .into_iter()
-                .filter(|t| t.dynamics_valid.is_set() && t.tick % KEEP_EVERY == 0),
-        );
+        for telemetry in batch.telemetry {
+            let now = telemetry.state.get().ok();
+            if now.is_some() && now != state {
+                state = now;
+                kept.changes.extend(now.map(|state| StateChange {
+                    tick: telemetry.tick,
+                    sample_timestamp_ns: telemetry.sample_timestamp_ns,
+                    state,
+                }));
+            }
+            if telemetry.dynamics_valid.is_set() && telemetry.tick % KEEP_EVERY == 0 {
+                kept.balance.push(telemetry);
+            }
+        }
     }
     kept
 }

@@ -12,7 +12,7 @@ use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 use shm_types::{DaemonStatus, SimTruth};
 use stance::PostProcessedSequence;
 
-use super::balance::BalanceRecorder;
+use super::balance::{BalanceRecorder, StateChange};
 use super::truth::{TruthRecorder, Verdict, state_at};
 use super::{BalanceSample, Points, TraceSample, align_targets};
 use crate::daemon_client::DaemonClient;
@@ -22,8 +22,10 @@ use crate::observe::{Recorder, RecorderOutcome};
 pub(crate) struct WatchOptions<'a> {
     /// Record the walk (an observer beside walkd) to this MCAP file.
     pub record: Option<PathBuf>,
-    /// Record the dynamic gait's ZMP and DCM telemetry.
+    /// Record the dynamic gait's ZMP and DCM telemetry and the daemon's state changes.
     pub balance: bool,
+    /// Keep recording this long after the walk ended (to see whether the robot stays up).
+    pub linger: Duration,
     /// How long the walk may take before it counts as stuck.
     pub timeout: Duration,
     /// Called with every status while the walk runs (e.g. a progress line).
@@ -55,6 +57,8 @@ pub(crate) struct WatchedWalk {
     pub drift: Option<(f64, usize)>,
     /// The ZMP and DCM telemetry, with [`WatchOptions::balance`].
     pub balance: Vec<BalanceSample>,
+    /// The ticks at which the daemon's state changed, with [`WatchOptions::balance`].
+    pub state_changes: Vec<StateChange>,
     /// The recording, with [`WatchOptions::record`].
     pub recording: Option<RecorderOutcome>,
 }
@@ -96,11 +100,12 @@ pub(crate) fn watch_walk(
         }
     })?;
     let wall_s = wall.elapsed().as_secs_f64();
+    std::thread::sleep(options.linger);
     let recording = observer.map(Recorder::finish).transpose()?;
     let states = recorder.finish()?;
-    let balance = match balance {
+    let (balance, state_changes) = match balance {
         Some(recorder) => recorder.finish(start.ticks, start.rate_hz)?,
-        None => Vec::new(),
+        None => (Vec::new(), Vec::new()),
     };
     let drift = pair_with_truth(&mut trace, &status_times, &states);
     // Simulated time from the submission to the tick of the last status: by the simulator's
@@ -125,6 +130,7 @@ pub(crate) fn watch_walk(
         trace,
         drift,
         balance,
+        state_changes,
         recording,
     })
 }

@@ -93,6 +93,13 @@ pub struct ControllerConfig {
     pub touchdown_force_fraction: f64,
     /// ... for this many consecutive ticks.
     pub touchdown_debounce_ticks: u32,
+    /// While a walk executes, the feet together must carry at least this fraction of the
+    /// weight, but for moments of up to `unloaded_max_s`; longer is a measurement fault (a
+    /// force-torque dropout: a walking robot always stands on a foot).
+    pub support_force_min_fraction: f64,
+    /// The longest moment the feet may carry less than that (s). MuJoCo's ARMAR-4 reads no foot
+    /// force for up to 16 ms at a time while it walks dynamically (its soles chatter).
+    pub unloaded_max_s: f64,
     /// Time allowed beyond a phase's planned duration before it is a fault (s).
     pub phase_timeout_s: f64,
     /// Longest step between consecutive contacts of one foot that a sequence may ask for (m).
@@ -171,6 +178,8 @@ impl Default for ControllerConfig {
             hand_orientation_tolerance_rad: 0.1,
             release_force_fraction: 0.1,
             touchdown_force_fraction: 0.1,
+            support_force_min_fraction: 0.1,
+            unloaded_max_s: 0.05,
             touchdown_debounce_ticks: 3,
             phase_timeout_s: 5.0,
             max_step_m: 0.5,
@@ -301,6 +310,7 @@ impl ControllerConfig {
             ("workspace_height_m", self.workspace_height_m),
             ("max_target_step_m", self.max_target_step_m),
             ("max_phase_s", self.max_phase_s),
+            ("unloaded_max_s", self.unloaded_max_s),
         ];
         let non_negative = [
             ("joint_limit_margin_rad", self.joint_limit_margin_rad),
@@ -313,6 +323,10 @@ impl ControllerConfig {
             ("velocity_limit_scale", self.velocity_limit_scale),
             ("release_force_fraction", self.release_force_fraction),
             ("touchdown_force_fraction", self.touchdown_force_fraction),
+            (
+                "support_force_min_fraction",
+                self.support_force_min_fraction,
+            ),
         ];
         let fail = |key, value, requirement| ConfigError::Value {
             origin: origin.to_owned(),

@@ -89,6 +89,9 @@ pub(crate) enum Progress {
     Running,
     Done,
     Fault(FaultCode),
+    /// A fault the walk answers with a controlled stop (dynamic gait): it keeps running until
+    /// the robot rests on both feet, then ends `Done`.
+    Stopping(FaultCode),
 }
 
 /// A CoM shift that stalled short of its goal (joint limits) still completes once it has sat

@@ -17,7 +17,14 @@
 //!    already is exerts no torque).
 //!
 //! A failed solve, an invalid measurement or a phase timeout holds the last safe command and
-//! enters [`ControllerState::Fault`].
+//! enters [`ControllerState::Fault`]. A dynamic walk cannot stop in single support (its DCM keeps
+//! moving), so there an invalid measurement (also: feet carrying less than
+//! `support_force_min_fraction` of the weight), a missed touchdown, a hold or an abort end it with a
+//! [`ControllerState::ControlledStop`] first: the swing foot lands, the robot comes to rest on both
+//! feet, then it holds (`docs/safety.md`, "Controlled stop"). A tick without a usable measurement
+//! meanwhile runs on the last valid state: the joints where the last command sent them, the last
+//! valid wrenches, no IMU, and the plan fed forward. What the controller cannot compute through (a
+//! failed solve, a non-finite command, lost support, tipping) holds at once.
 //!
 //! Joint limits are a hard guarantee: every command written is finite and inside the URDF
 //! limits. A measurement is invalid when it has the wrong size, a non-finite value, or a joint
@@ -112,6 +119,8 @@ pub enum StartRefusal {
     NotUpright,
     /// A dynamic walk must start on both feet, and the robot does not stand on them.
     NotOnBothFeet,
+    /// A controlled stop is under way.
+    Stopping,
 }
 
 impl StartRefusal {
@@ -131,6 +140,9 @@ impl StartRefusal {
                 "a dynamic walk starts on both feet, and the robot does not stand on both: \
                  finish on both feet with a static walk first"
             }
+            Self::Stopping => {
+                "a controlled stop is under way: the robot comes to rest on both feet first"
+            }
         }
     }
 }
@@ -140,6 +152,8 @@ impl StartRefusal {
 pub enum ResetRefusal {
     /// A tipping fault stays until the IMU shows the robot upright again.
     NotUpright,
+    /// A fault's controlled stop is under way; it is acknowledged once the robot rests.
+    Stopping,
 }
 
 impl ResetRefusal {
@@ -149,6 +163,10 @@ impl ResetRefusal {
             Self::NotUpright => {
                 "the robot is not upright (its IMU is tilted beyond tipping_detection_rad): stand \
                  it upright (or restart the simulator), then send hold again"
+            }
+            Self::Stopping => {
+                "a controlled stop is under way (the swing foot lands, the robot comes to rest on \
+                 both feet): send hold again once it holds"
             }
         }
     }
@@ -214,6 +232,17 @@ pub struct Controller {
     measurement_refused: bool,
     /// The IMU orientation of the last valid measurement.
     last_imu: Option<UnitQuaternion<f64>>,
+    /// The wrenches of the last valid measurement (a tick on the last valid state reads them).
+    last_wrenches: [[f64; 6]; 4],
+    /// Joint angles and velocities of a tick on the last valid state (preallocated).
+    substitute_q: Vec<f64>,
+    substitute_qd: Vec<f64>,
+    /// Where a controlled stop ends: `Fault` when a fault caused it, else `Holding`.
+    stop_ends_in: ControllerState,
+    /// The robot's weight (N).
+    weight: f64,
+    /// How long the feet have carried less than `support_force_min_fraction` of it (s).
+    unloaded_s: f64,
     status: ControllerStatus,
 }
 
@@ -248,6 +277,12 @@ impl Controller {
             world_ready: false,
             measurement_refused: false,
             last_imu: None,
+            last_wrenches: [[0.0; 6]; 4],
+            substitute_q: vec![0.0; model.dof()],
+            substitute_qd: vec![0.0; model.dof()],
+            stop_ends_in: ControllerState::Holding,
+            weight,
+            unloaded_s: 0.0,
             status: ControllerStatus::default(),
             solver,
             config,
@@ -294,6 +329,7 @@ impl Controller {
     ) -> Result<Option<Box<PreparedSequence>>, (Box<PreparedSequence>, StartRefusal)> {
         let refusal = match self.status.state {
             ControllerState::Executing => Some(StartRefusal::Busy),
+            ControllerState::ControlledStop => Some(StartRefusal::Stopping),
             ControllerState::Fault => Some(StartRefusal::Faulted),
             _ if self.measurement_refused => Some(StartRefusal::NoMeasurement),
             _ if !self.upright() => Some(StartRefusal::NotUpright),
@@ -319,24 +355,149 @@ impl Controller {
     #[must_use]
     pub fn tick(&mut self, measurement: &Measurement, dt: f64, out: &mut Command) -> bool {
         self.status.ticks += 1;
-        if let Err(fault) = self.check_measurement(measurement, dt) {
-            return self.refuse_measurement(fault, out);
+        if let Err(fault) = self
+            .check_measurement(measurement, dt)
+            .and_then(|()| self.check_load(measurement, dt))
+        {
+            return self.refuse_measurement(fault, dt, out);
         }
         self.measurement_refused = false;
         self.last_imu = measurement.imu_orientation;
+        self.last_wrenches = *measurement.wrenches;
+        self.control(measurement, dt, out, true)
+    }
+
+    /// RT: a measurement that could not even be decoded (e.g. a flag byte that is neither 0
+    /// nor 1) or failed its checks: fault with `fault`. A dynamic walk ends with a controlled
+    /// stop, and this tick runs on the last valid state; otherwise the robot holds. Returns
+    /// whether `out` holds a command (see [`Controller::tick`]).
+    #[must_use]
+    pub fn refuse_measurement(
+        &mut self,
+        fault: MeasurementFault,
+        dt: f64,
+        out: &mut Command,
+    ) -> bool {
+        self.measurement_refused = true;
+        let force_sensors_sane = !matches!(
+            fault,
+            MeasurementFault::Unloaded(_) | MeasurementFault::NonFiniteWrench(_)
+        );
+        self.stop_for(FaultCode::InvalidMeasurement(fault), force_sensors_sane);
+        if self.status.state != ControllerState::ControlledStop || !(dt.is_finite() && dt > 0.0) {
+            return self.write_hold(out);
+        }
+        self.tick_on_last_state(dt, out)
+    }
+
+    /// RT: the adapter restarted, or its link came back after the watchdog tripped: the robot
+    /// may stand anywhere now. The world frame, the base estimate and the hold posture are set
+    /// up again from the next valid measurement (no command until then); a walk in progress
+    /// faults with [`FaultCode::AdapterRestarted`].
+    pub fn relink(&mut self) {
+        if matches!(
+            self.status.state,
+            ControllerState::Executing | ControllerState::ControlledStop
+        ) {
+            self.enter_fault(FaultCode::AdapterRestarted);
+        }
+        self.world_ready = false;
+        self.measurement_refused = true;
+    }
+
+    /// RT: stops executing and holds (→ Holding), as [`hold`](Self::hold) does.
+    pub fn abort(&mut self) {
+        self.hold();
+    }
+
+    /// RT: holds the last command (→ Holding), from any state except a fault; a dynamic walk
+    /// under way ends with a controlled stop first (→ ControlledStop → Holding), and a stop
+    /// under way goes on. The last command rather than the measured posture, so loaded joints
+    /// keep their holding torque.
+    pub fn hold(&mut self) {
+        match self.status.state {
+            ControllerState::Fault | ControllerState::ControlledStop => {}
+            ControllerState::Executing if self.machine.stop_early(true) => {
+                self.status.state = ControllerState::ControlledStop;
+                self.stop_ends_in = ControllerState::Holding;
+            }
+            _ => {
+                self.machine.stop();
+                self.status.state = ControllerState::Holding;
+                self.status.phase = Phase::None;
+            }
+        }
+    }
+
+    /// RT: acknowledges a fault (→ Holding the last safe command); no effect otherwise. A
+    /// tipping fault is acknowledged only once the IMU shows the robot upright; the world frame
+    /// and the base estimate then restart from the next measurement.
+    pub fn reset(&mut self) -> Result<(), ResetRefusal> {
+        if self.status.state == ControllerState::ControlledStop
+            && self.stop_ends_in == ControllerState::Fault
+        {
+            return Err(ResetRefusal::Stopping);
+        }
+        if self.status.state != ControllerState::Fault {
+            return Ok(());
+        }
+        if self.status.fault == FaultCode::Tipping {
+            if !self.upright() {
+                return Err(ResetRefusal::NotUpright);
+            }
+            self.world_ready = false;
+        }
+        self.machine.stop();
+        self.status.state = ControllerState::Holding;
+        self.status.phase = Phase::None;
+        Ok(())
+    }
+
+    /// The status of the last tick.
+    pub fn status(&self) -> &ControllerStatus {
+        &self.status
+    }
+
+    /// Row capacities (equality, inequality) of the controller's QPs, to size a solver for them.
+    pub fn qp_capacity() -> (usize, usize) {
+        (assembly::MAX_EQUALITY_ROWS, assembly::MAX_INEQUALITY_ROWS)
+    }
+
+    /// The QP of the last executing tick (for export and solver comparison).
+    pub fn last_problem(&self) -> &QpProblem {
+        self.assembler.problem()
+    }
+
+    /// The robot controlled.
+    pub fn robot(&self) -> &Arc<Robot> {
+        &self.robot
+    }
+
+    /// One control step on `measurement` (`measured`: a real one, else the last valid state):
+    /// estimation, the state machine, the QP and the command.
+    fn control(
+        &mut self,
+        measurement: &Measurement,
+        dt: f64,
+        out: &mut Command,
+        measured: bool,
+    ) -> bool {
         self.configuration.joints.copy_from_slice(measurement.q);
         if !self.world_ready {
             self.initialise_world(measurement);
         }
-        if !self.estimate(measurement) {
+        if !self.estimate(measurement, measured) {
             self.enter_fault(FaultCode::LostSupport);
             return self.write_hold(out);
         }
-        if self.tipping(measurement) {
+        if measured && self.tipping(measurement) {
             self.enter_fault(FaultCode::Tipping);
             return self.write_hold(out);
         }
-        if self.status.state != ControllerState::Executing {
+        if !matches!(
+            self.status.state,
+            ControllerState::Executing | ControllerState::ControlledStop
+        ) {
             return self.write_hold(out);
         }
         let feedback = Feedback {
@@ -356,13 +517,19 @@ impl Controller {
             }),
             base_rotation: self.configuration.base.rotation,
             imu: measurement.imu_orientation,
+            measured,
         };
         match self.machine.update(&feedback, sensors, dt) {
             Progress::Running => {}
+            Progress::Stopping(code) => self.stop_for(code, false),
             Progress::Done => {
                 // Keep holding the last command: it carries the servo offsets of the load.
-                self.status.state = ControllerState::Done;
+                self.status.state = match self.status.state {
+                    ControllerState::ControlledStop => self.stop_ends_in,
+                    _ => ControllerState::Done,
+                };
                 self.publish_progress();
+                self.status.phase = Phase::None;
                 return self.write_hold(out);
             }
             Progress::Fault(code) => {
@@ -404,81 +571,69 @@ impl Controller {
         self.write_track(measurement, dt, out)
     }
 
-    /// RT: a measurement that could not even be decoded (e.g. a flag byte that is neither 0
-    /// nor 1) or failed its checks: fault with `fault` and hold. Returns whether `out` holds
-    /// a command (see [`Controller::tick`]).
-    #[must_use]
-    pub fn refuse_measurement(&mut self, fault: MeasurementFault, out: &mut Command) -> bool {
-        self.measurement_refused = true;
-        self.enter_fault(FaultCode::InvalidMeasurement(fault));
-        self.write_hold(out)
+    /// A tick of a controlled stop without a usable measurement: on the last valid state, the
+    /// joints where the last command sent them (see the module docs). Allocation-free.
+    fn tick_on_last_state(&mut self, dt: f64, out: &mut Command) -> bool {
+        let mut q = std::mem::take(&mut self.substitute_q);
+        let qd = std::mem::take(&mut self.substitute_qd);
+        q.copy_from_slice(self.last_command.as_slice());
+        let wrenches = self.last_wrenches;
+        let state = Measurement {
+            q: &q,
+            qd: &qd,
+            wrenches: &wrenches,
+            imu_orientation: None,
+        };
+        let written = self.control(&state, dt, out, false);
+        self.substitute_q = q;
+        self.substitute_qd = qd;
+        written
     }
 
-    /// RT: the adapter restarted, or its link came back after the watchdog tripped: the robot
-    /// may stand anywhere now. The world frame, the base estimate and the hold posture are set
-    /// up again from the next valid measurement (no command until then); a walk in progress
-    /// faults with [`FaultCode::AdapterRestarted`].
-    pub fn relink(&mut self) {
-        if self.status.state == ControllerState::Executing {
-            self.enter_fault(FaultCode::AdapterRestarted);
+    /// A fault the dynamic gait answers with a controlled stop (see the module docs), on the
+    /// force-torque sensors' word when `force_sensors_sane`; a stop under way goes on and now
+    /// ends in `Fault`. Anything else faults and holds at once.
+    fn stop_for(&mut self, code: FaultCode, force_sensors_sane: bool) {
+        match self.status.state {
+            ControllerState::Executing if self.machine.stop_early(force_sensors_sane) => {
+                self.status.state = ControllerState::ControlledStop;
+                self.status.fault = code;
+                self.stop_ends_in = ControllerState::Fault;
+            }
+            ControllerState::ControlledStop => {
+                self.machine.stop_early(force_sensors_sane);
+                if self.stop_ends_in != ControllerState::Fault {
+                    self.status.fault = code;
+                    self.stop_ends_in = ControllerState::Fault;
+                }
+            }
+            _ => self.enter_fault(code),
         }
-        self.world_ready = false;
-        self.measurement_refused = true;
     }
 
-    /// RT: stops executing and holds the current posture (→ Holding).
-    pub fn abort(&mut self) {
-        self.hold();
-    }
-
-    /// RT: holds the last command (→ Holding), from any state except a fault. The last command
-    /// rather than the measured posture, so loaded joints keep their holding torque.
-    pub fn hold(&mut self) {
-        if self.status.state == ControllerState::Fault {
-            return;
-        }
-        self.machine.stop();
-        self.status.state = ControllerState::Holding;
-        self.status.phase = Phase::None;
-    }
-
-    /// RT: acknowledges a fault (→ Holding the last safe command); no effect otherwise. A
-    /// tipping fault is acknowledged only once the IMU shows the robot upright; the world frame
-    /// and the base estimate then restart from the next measurement.
-    pub fn reset(&mut self) -> Result<(), ResetRefusal> {
-        if self.status.state != ControllerState::Fault {
+    /// While a walk executes on force-torque it trusts, the feet must carry at least
+    /// `support_force_min_fraction` of the weight, but for moments of up to `unloaded_max_s` (a
+    /// sole rocking off the ground for a tick is physics; a robot that stays unloaded has lost
+    /// its force-torque sensors, or the ground).
+    fn check_load(&mut self, m: &Measurement, dt: f64) -> Result<(), MeasurementFault> {
+        let walking = matches!(
+            self.status.state,
+            ControllerState::Executing | ControllerState::ControlledStop
+        );
+        let load = m.wrenches[EndEffector::LeftFoot as usize][2]
+            + m.wrenches[EndEffector::RightFoot as usize][2];
+        if !walking
+            || !self.machine.trusts_force_sensors()
+            || load >= self.config.support_force_min_fraction * self.weight
+        {
+            self.unloaded_s = 0.0;
             return Ok(());
         }
-        if self.status.fault == FaultCode::Tipping {
-            if !self.upright() {
-                return Err(ResetRefusal::NotUpright);
-            }
-            self.world_ready = false;
+        self.unloaded_s += dt;
+        if self.unloaded_s <= self.config.unloaded_max_s {
+            return Ok(());
         }
-        self.machine.stop();
-        self.status.state = ControllerState::Holding;
-        self.status.phase = Phase::None;
-        Ok(())
-    }
-
-    /// The status of the last tick.
-    pub fn status(&self) -> &ControllerStatus {
-        &self.status
-    }
-
-    /// Row capacities (equality, inequality) of the controller's QPs, to size a solver for them.
-    pub fn qp_capacity() -> (usize, usize) {
-        (assembly::MAX_EQUALITY_ROWS, assembly::MAX_INEQUALITY_ROWS)
-    }
-
-    /// The QP of the last executing tick (for export and solver comparison).
-    pub fn last_problem(&self) -> &QpProblem {
-        self.assembler.problem()
-    }
-
-    /// The robot controlled.
-    pub fn robot(&self) -> &Arc<Robot> {
-        &self.robot
+        Err(MeasurementFault::Unloaded(load.max(0.0) as u32))
     }
 
     /// The first thing wrong with `m`, if anything: size, finiteness, joint limits.
@@ -550,12 +705,17 @@ impl Controller {
         self.world_ready = true;
     }
 
-    /// Leg odometry; false if no foot is anchored.
-    fn estimate(&mut self, measurement: &Measurement) -> bool {
-        let weights = [
-            measurement.wrenches[EndEffector::LeftFoot as usize][2],
-            measurement.wrenches[EndEffector::RightFoot as usize][2],
-        ];
+    /// Leg odometry, the anchored feet weighted by their measured load (equally when the
+    /// force-torque readings are not trusted); false if no foot is anchored.
+    fn estimate(&mut self, measurement: &Measurement, measured: bool) -> bool {
+        let weights = if measured && self.machine.trusts_force_sensors() {
+            [
+                measurement.wrenches[EndEffector::LeftFoot as usize][2],
+                measurement.wrenches[EndEffector::RightFoot as usize][2],
+            ]
+        } else {
+            [1.0, 1.0]
+        };
         let ok = self.estimator.update(
             &self.robot,
             &mut self.kinematics,

@@ -62,6 +62,18 @@ impl Sequencer {
         self.fallback.stop();
     }
 
+    /// Ends a dynamic walk under way with a controlled stop (`DynamicWalker::stop_early`);
+    /// false when no dynamic walk is under way (the static gait holds at once).
+    pub fn stop_early(&mut self, trust_force_sensors: bool) -> bool {
+        self.dynamic.running() && self.dynamic.stop_early(trust_force_sensors)
+    }
+
+    /// Whether the feet's force-torque readings are trusted: false during a controlled stop that
+    /// distrusts them.
+    pub fn trusts_force_sensors(&self) -> bool {
+        !self.dynamic.running() || self.dynamic.trusts_force_sensors()
+    }
+
     /// One tick of the running sequence. `sensors` is called only for a dynamic walk.
     pub fn update<'a>(
         &mut self,
@@ -76,7 +88,7 @@ impl Sequencer {
             self.dynamic.take_over(self.fallback.targets());
         }
         let progress = self.dynamic.update(feedback, &sensors(), dt);
-        if progress != Progress::Running {
+        if matches!(progress, Progress::Done | Progress::Fault(_)) {
             self.fallback.adopt(self.dynamic.targets());
         }
         progress

@@ -12,6 +12,10 @@ pub enum ControllerState {
     Holding,
     /// Executing a sequence; see [`ControllerStatus::phase`] and the stance index.
     Executing,
+    /// A dynamic walk ends early under control (a fault, or a hold or abort request): the swing
+    /// foot lands and the robot comes to rest on both feet, then it holds (→ `Fault` when a fault
+    /// caused the stop, see [`ControllerStatus::fault`], else → `Holding`).
+    ControlledStop,
     /// The sequence finished; holding the final posture.
     Done,
     /// Something went wrong; holding the last safe command. See [`ControllerStatus::fault`].
@@ -25,6 +29,7 @@ impl ControllerState {
             Self::Idle => "idle",
             Self::Holding => "holding",
             Self::Executing => "executing",
+            Self::ControlledStop => "controlled_stop",
             Self::Done => "done",
             Self::Fault => "fault",
         }
@@ -112,6 +117,9 @@ pub enum FaultCode {
     MissedTouchdown,
     /// Dynamic gait: a walk starts standing on both feet, and the robot did not.
     NotOnBothFeet,
+    /// Dynamic gait: a controlled stop could not land its swing foot (no force-torque contact
+    /// and the sole not at its foothold's height): the robot holds on one foot.
+    StopCouldNotLand,
 }
 
 impl FaultCode {
@@ -141,6 +149,10 @@ impl FaultCode {
             Self::Timeout(_) => "timeout",
             Self::MissedTouchdown => "missed touchdown: force-torque never confirmed the landing",
             Self::NotOnBothFeet => "a dynamic walk starts on both feet",
+            Self::StopCouldNotLand => {
+                "the controlled stop could not land the swing foot (no contact where its foothold \
+                 should be): holding on one foot"
+            }
         }
     }
 
@@ -165,6 +177,7 @@ impl FaultCode {
             Self::Timeout(_) => "timeout",
             Self::MissedTouchdown => "missed_touchdown",
             Self::NotOnBothFeet => "not_on_both_feet",
+            Self::StopCouldNotLand => "stop_could_not_land",
         }
     }
 }
@@ -218,6 +231,12 @@ impl core::fmt::Display for FaultDescription<'_> {
                 write!(f, "{field} holds {value}, expected 0 or 1")
             }
             MeasurementFault::BadTimeStep => f.write_str("the time step is not positive"),
+            MeasurementFault::Unloaded(newtons) => write!(
+                f,
+                "the feet carry {newtons} N of the robot's {:.0} N weight while it walks (a \
+                 force-torque dropout?)",
+                self.robot.model.total_mass() * kinematics::ground::GRAVITY
+            ),
         }
     }
 }
@@ -246,6 +265,9 @@ pub enum MeasurementFault {
     },
     /// The control period is not a positive number.
     BadTimeStep,
+    /// While a walk executes, the feet carry less than `support_force_min_fraction` of the
+    /// robot's weight (N, the sum measured): a force-torque dropout, or the robot off the ground.
+    Unloaded(u32),
 }
 
 /// Everything a client or log needs about the controller, updated every tick (plain data).

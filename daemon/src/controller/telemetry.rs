@@ -45,7 +45,10 @@ impl Controller {
                 targets.end_effectors[i].map(|t| pose_array(&t.pose))
             };
         }
-        let executing = status.state == ControllerState::Executing;
+        let executing = matches!(
+            status.state,
+            ControllerState::Executing | ControllerState::ControlledStop
+        );
         ControllerTelemetry {
             status: *status,
             gait: self.machine.gait(),

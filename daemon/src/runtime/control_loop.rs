@@ -118,6 +118,8 @@ pub struct ControlLoop {
     /// More than one process publishes on `sensors` (checked with each status).
     second_adapter: bool,
     last_state: ControllerState,
+    /// The fault last recorded in `faults` (`None` outside a fault or controlled stop).
+    last_fault: FaultCode,
     /// A sequence to free that did not fit into the outbox yet (never freed here).
     release_later: Option<Box<PreparedSequence>>,
     status: DaemonStatus,
@@ -159,6 +161,7 @@ impl ControlLoop {
             faults: FaultLog::new(),
             second_adapter: false,
             last_state: ControllerState::Idle,
+            last_fault: FaultCode::None,
             release_later: None,
             status,
             next_status_ns: 0,
@@ -413,7 +416,9 @@ impl ControlLoop {
         let dt = self.timing.period_ns as f64 * 1e-9;
         match decode::measurement(&self.sample, self.dof) {
             Ok(measurement) => self.controller.tick(&measurement, dt, &mut self.command),
-            Err(fault) => self.controller.refuse_measurement(fault, &mut self.command),
+            Err(fault) => self
+                .controller
+                .refuse_measurement(fault, dt, &mut self.command),
         }
     }
 
@@ -552,21 +557,32 @@ impl ControlLoop {
         }
     }
 
-    /// Follows the controller's state: records the cause of a new fault, forgets old faults
-    /// when a walk ends `done`. Returns whether the state changed.
+    /// Follows the controller's state: records the cause of a new fault (a controlled stop
+    /// reports its cause when it begins, and a fault that ends the stop after it), forgets old
+    /// faults when a walk ends `done`. Returns whether the state or the fault changed.
     fn note_state_change(&mut self) -> bool {
         let status = self.controller.status();
-        if status.state == self.last_state {
+        let faulted = matches!(
+            status.state,
+            ControllerState::Fault | ControllerState::ControlledStop
+        );
+        let new_fault =
+            faulted && status.fault != FaultCode::None && status.fault != self.last_fault;
+        if status.state == self.last_state && !new_fault {
             return false;
         }
-        match status.state {
-            ControllerState::Fault if status.fault != FaultCode::None => {
-                self.faults
-                    .record(status.fault.describe_for(self.controller.robot()));
-            }
-            ControllerState::Done => self.faults.clear(),
-            _ => {}
+        if new_fault {
+            self.faults
+                .record(status.fault.describe_for(self.controller.robot()));
         }
+        if status.state == ControllerState::Done {
+            self.faults.clear();
+        }
+        self.last_fault = if faulted {
+            status.fault
+        } else {
+            FaultCode::None
+        };
         self.last_state = status.state;
         true
     }
@@ -594,6 +610,7 @@ impl ControlLoop {
             ControllerState::Idle => DaemonState::Idle,
             ControllerState::Holding => DaemonState::Holding,
             ControllerState::Executing => DaemonState::Executing,
+            ControllerState::ControlledStop => DaemonState::ControlledStop,
             ControllerState::Done => DaemonState::Done,
             ControllerState::Fault => DaemonState::Fault,
         }

@@ -206,6 +206,13 @@ impl Requests {
                 status.sequence_id, status.stance_index, status.stance_count
             ));
         }
+        if status.state == DaemonState::ControlledStop {
+            return Err(format!(
+                "sequence {} is coming to a controlled stop: the robot comes to rest on both feet \
+                 first",
+                status.sequence_id
+            ));
+        }
         let text = std::str::from_utf8(json)
             .map_err(|e| format!("the submission is not UTF-8 JSON: {e}"))?;
         let stances =

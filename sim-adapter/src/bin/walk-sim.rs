@@ -4,7 +4,11 @@
 //! walk-sim --config configs/armar4.toml --physics kinematic|mujoco [--clock realtime|lockstep]
 //!          [--rate-hz F] [--urdf PATH] [--service-prefix P]
 //!          [--snapshots DIR [--snapshot-period S] [--snapshot-lookat X,Y,Z]]
+//!          [--inject KIND [--inject-step K] [--inject-delay S]]
 //! ```
+//! With `--inject` (evaluation of the controlled stop, `sim_adapter::inject`) it reports one bad
+//! sample, withholds a touchdown or asks walkd for a hold or abort, `--inject-delay` seconds of
+//! simulated time after the `--inject-step`-th lift-off of a foot.
 //! With `--snapshots` (MuJoCo only, feature `render`) it saves a side view of the robot every
 //! `--snapshot-period` of simulated time (`sim_adapter::mujoco::render`).
 //! Besides the adapter side of the contract it publishes the simulator's ground truth (CoM,
@@ -21,10 +25,13 @@ use clap::Parser;
 use kinematic_sim::{KinematicSim, Simulator};
 use kinematics::ConfigFile;
 use kinematics::robot::Robot;
-use shm_types::process::{Physics, exit_code, install_termination_handler, termination_requested};
+use shm_types::process::{
+    InjectedFault, Physics, exit_code, install_termination_handler, termination_requested,
+};
 use shm_types::{
     AdapterPorts, ClockMode, RuntimeConfig, ServiceNames, TruthPublisher, current_thread_is_fifo,
 };
+use sim_adapter::inject::{FaultInjector, FaultPlan};
 use sim_adapter::{AdapterOptions, PublishTruth, SimulatedRobot, run_adapter};
 
 /// Simulated robot for walkd: publishes sensor samples, applies joint commands.
@@ -60,6 +67,36 @@ struct Args {
     /// The point the side camera looks at: x,y,z (m, world).
     #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.0, 0.8])]
     snapshot_lookat: Vec<f64>,
+    /// Fault injection for evaluation: what goes wrong (a NaN or out-of-limit joint in one
+    /// sample, one sample without foot forces, a hold or abort request, a withheld touchdown).
+    #[arg(long)]
+    inject: Option<InjectedFault>,
+    /// With --inject: after this lift-off of a foot (1: the walk's first step).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    inject_step: u32,
+    /// With --inject: this long after that lift-off (s of simulated time, 0–10).
+    #[arg(long, default_value_t = 0.0)]
+    inject_delay: f64,
+}
+
+impl Args {
+    /// The fault to inject, if any (its delay checked).
+    fn fault_plan(&self) -> Result<Option<FaultPlan>, (u8, anyhow::Error)> {
+        let Some(kind) = self.inject else {
+            return Ok(None);
+        };
+        if !(0.0..=10.0).contains(&self.inject_delay) {
+            return Err((
+                exit_code::USAGE,
+                anyhow::anyhow!("--inject-delay {} must be in [0, 10] s", self.inject_delay),
+            ));
+        }
+        Ok(Some(FaultPlan {
+            kind,
+            step: self.inject_step,
+            delay_s: self.inject_delay,
+        }))
+    }
 }
 
 fn main() -> ExitCode {
@@ -106,7 +143,7 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
             let standing = robot.standing.clone();
             let sim = KinematicSim::new(robot, standing)
                 .map_err(|e| config_error(anyhow::Error::from(e).context("standing posture")))?;
-            serve(&runtime, args.clock, SimulatedRobot::new(sim))
+            serve(&runtime, args, SimulatedRobot::new(sim))
         }
         Physics::Mujoco => serve_mujoco(robot, &runtime, args),
     }
@@ -128,7 +165,7 @@ fn serve_mujoco(
         )
     })?;
     match &args.snapshots {
-        None => serve(runtime, args.clock, SimulatedRobot::new(sim)),
+        None => serve(runtime, args, SimulatedRobot::new(sim)),
         Some(dir) => serve_with_snapshots(runtime, args, sim, dir),
     }
 }
@@ -151,7 +188,7 @@ fn serve_with_snapshots(
     let options = SnapshotOptions::side_view(dir.to_owned(), args.snapshot_period, [x, y, z]);
     let sim = PhotographedSim::new(sim, options)
         .map_err(|e| (exit_code::CONFIG, anyhow::Error::from(e)))?;
-    serve(runtime, args.clock, SimulatedRobot::new(sim))
+    serve(runtime, args, SimulatedRobot::new(sim))
 }
 
 /// `--snapshots DIR` in a build without the renderer: says how to get it.
@@ -188,18 +225,20 @@ fn serve_mujoco(
 }
 
 /// Runs the adapter loop for `sim` until terminated, publishing its ground truth with every
-/// sample; logs the simulator's safety summary.
+/// sample (and injecting the fault of `--inject`); logs the simulator's safety summary.
 fn serve<S: Simulator>(
     runtime: &RuntimeConfig,
-    clock: ClockMode,
+    args: &Args,
     sim: SimulatedRobot<S>,
 ) -> Result<(), (u8, anyhow::Error)> {
+    let (clock, fault) = (args.clock, args.fault_plan()?);
+    let limit_fault = (0, sim.sim().robot().model.joint_limits()[0].upper);
     let names =
         ServiceNames::new(&runtime.service_prefix).map_err(|e| (exit_code::IPC, e.into()))?;
     let ports = AdapterPorts::open(&names, "walk-sim").map_err(|e| (exit_code::IPC, e.into()))?;
     let truth =
         TruthPublisher::open(&names, "walk-sim-truth").map_err(|e| (exit_code::IPC, e.into()))?;
-    let mut sim = PublishTruth::new(sim, truth);
+    let sim = PublishTruth::new(sim, truth);
     install_termination_handler();
     // Busy-wait the end of each period like walkd does, and only where it pays off: on
     // SCHED_FIFO (e.g. `chrt -f`), in real time.
@@ -222,9 +261,25 @@ fn serve<S: Simulator>(
         spin_us = spin.as_micros() as u64,
         "walk-sim running"
     );
-    let report = run_adapter(&ports, &mut sim, &options, &termination_requested)
-        .map_err(|e| (exit_code::IPC, e.into()))?;
-    let safety = *sim.robot().sim().summary();
+    let (report, safety) = match fault {
+        None => {
+            let mut sim = sim;
+            let report = run_adapter(&ports, &mut sim, &options, &termination_requested);
+            (report, *sim.robot().sim().summary())
+        }
+        Some(plan) => {
+            tracing::info!(
+                fault = plan.kind.name(),
+                step = plan.step,
+                delay_s = plan.delay_s,
+                "fault injection armed"
+            );
+            let mut sim = FaultInjector::new(sim, plan, limit_fault, &names);
+            let report = run_adapter(&ports, &mut sim, &options, &termination_requested);
+            (report, *sim.robot().robot().sim().summary())
+        }
+    };
+    let report = report.map_err(|e| (exit_code::IPC, e.into()))?;
     tracing::info!(
         samples = report.samples,
         commands = report.commands,

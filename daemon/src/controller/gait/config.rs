@@ -38,6 +38,9 @@ pub struct DynamicGaitConfig {
     /// The double support after the last touchdown: the ZMP returns to the centre of the feet
     /// and the CoM comes to rest (s).
     pub final_double_support_s: f64,
+    /// The double support that ends a controlled stop: after the step under way lands, the ZMP
+    /// crosses to the centre of both feet and the CoM comes to rest (s; docs/safety.md).
+    pub stop_double_support_s: f64,
     /// A transition that changes only hand contacts: the hands reach, the feet stay (s).
     pub hand_transition_s: f64,
     /// Height of the CoM above the support surface, the pendulum length `h` of ω² = g / h (m);
@@ -86,6 +89,7 @@ impl Default for DynamicGaitConfig {
             double_support_s: 0.1,
             initial_double_support_s: 1.0,
             final_double_support_s: 1.0,
+            stop_double_support_s: 0.6,
             hand_transition_s: 0.5,
             com_height_m: None,
             landing_depth_m: 0.001,
@@ -292,6 +296,7 @@ impl DynamicGaitConfig {
                 "final_double_support_s",
                 self.final_double_support_s,
             ),
+            (DYNAMIC, "stop_double_support_s", self.stop_double_support_s),
             (DYNAMIC, "hand_transition_s", self.hand_transition_s),
             (DYNAMIC, "com_height_m", self.com_height_m.unwrap_or(1.0)),
             (DYNAMIC, "hand_weight", self.hand_weight.unwrap_or(1.0)),

@@ -96,7 +96,9 @@ impl DcmPattern {
         let first = phases.first().expect("a plan has phases");
         let last = phases.last().expect("a plan has phases");
         let rest = feet_centre(&last.feet);
-        let capacity = (TRANSFER_PIECES + 1) * (phases.len() + 1);
+        // Room for every phase's pieces, and for the crossing a controlled stop appends
+        // ([`end_early`](Self::end_early)) without allocating on the control thread.
+        let capacity = (TRANSFER_PIECES + 1) * (phases.len() + 2);
         let mut segments: Vec<ZmpSegment> = Vec::with_capacity(capacity);
         // The ZMP where the double supports since the last single support began, and when.
         let mut crossing = (feet_centre(&first.feet), 0.0);
@@ -126,6 +128,39 @@ impl DcmPattern {
         };
         pattern.recurse(pattern.segments.len(), rest);
         pattern
+    }
+
+    /// Ends the walk early (a controlled stop): every piece before plan time `from_s` is kept (a
+    /// piece running at `from_s` is cut there), then the ZMP crosses from where it is at
+    /// `from_s` to `rest` over `duration_s` and the pattern comes to rest there. The backward
+    /// recursion runs again from the new rest, so the DCM reference from now on is the one that
+    /// stops the pendulum over `rest`. Allocation-free: [`new`](Self::new) reserved the room.
+    pub fn end_early(&mut self, from_s: f64, rest: Vector2<f64>, duration_s: f64) {
+        let mut keep = self
+            .segments
+            .partition_point(|segment| segment.end_s() <= from_s + 1e-9);
+        let from = match self.segments.get_mut(keep) {
+            Some(running) if running.start_s < from_s - 1e-9 => {
+                let zmp = running.zmp_start + running.zmp_velocity() * (from_s - running.start_s);
+                running.duration_s = from_s - running.start_s;
+                running.zmp_end = zmp;
+                keep += 1;
+                zmp
+            }
+            Some(next) if keep == 0 => next.zmp_start,
+            _ => self.segments[..keep]
+                .last()
+                .map_or(rest, |kept| kept.zmp_end),
+        };
+        self.segments.truncate(keep);
+        debug_assert!(self.segments.capacity() - self.segments.len() >= TRANSFER_PIECES);
+        push_crossing(
+            &mut self.segments,
+            (from, from_s),
+            (rest, from_s + duration_s),
+        );
+        self.rest = rest;
+        self.recurse(self.segments.len(), rest);
     }
 
     /// The backward recursion over the first `count` pieces, from the DCM `end` at their end.

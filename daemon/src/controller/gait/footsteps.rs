@@ -155,6 +155,50 @@ impl FootstepPlan {
         Ok(builder.plan)
     }
 
+    /// Ends the plan with phase `current` of transition `transition` (a controlled stop) and
+    /// returns the final double support: after a single support, its swing lands as planned and
+    /// both feet then carry the robot for `duration_s`; in a double support (at plan time
+    /// `now_s`) no foot lifts off and it lasts until `now_s + duration_s`. The current transition
+    /// becomes the last, so its stance stays the posture reference. Allocation-free.
+    pub fn end_early(
+        &mut self,
+        current: usize,
+        transition: usize,
+        now_s: f64,
+        duration_s: f64,
+    ) -> SupportPhase {
+        let phase = self.phases[current];
+        self.phases.truncate(current + 1);
+        let last = match phase.support {
+            Support::Single(swing) => {
+                let mut feet = phase.feet;
+                feet[slot(swing.foot)] = Some(swing.landing);
+                let last = SupportPhase {
+                    support: Support::Double { lift_off: None },
+                    start_s: phase.end_s(),
+                    duration_s,
+                    feet,
+                };
+                self.phases.push(last);
+                last
+            }
+            Support::Double { .. } => {
+                let last = SupportPhase {
+                    support: Support::Double { lift_off: None },
+                    duration_s: now_s + duration_s - phase.start_s,
+                    ..phase
+                };
+                self.phases[current] = last;
+                last
+            }
+        };
+        self.transitions.truncate(transition + 1);
+        if let Some(ending) = self.transitions.last_mut() {
+            ending.phases.end = self.phases.len();
+        }
+        last
+    }
+
     /// Planned duration of the whole walk (s).
     #[cfg(test)]
     pub fn duration_s(&self) -> f64 {

@@ -20,6 +20,18 @@
 //! hand reaches its contact pose with a minimum-jerk motion timed over the transition and is in
 //! contact at its end. After the last phase the walk settles: done once the CoM and the commanded
 //! DCM are within `com_tolerance_m` of the final feet's centre.
+//!
+//! A walk that must end early ends with a controlled stop ([`DynamicWalker::stop_early`],
+//! `docs/safety.md`): the plan is cut after the step under way — a swinging foot lands at its
+//! planned foothold, no foot lifts off again — and the ZMP crosses to the centre of both feet over
+//! `stop_double_support_s`; the DCM comes to rest there and the walk settles as it would at its
+//! end. A stop that distrusts the feet's force-torque sensors (they read no load, or never
+//! confirmed a touchdown), and every tick that runs on the last valid state instead of a
+//! measurement ([`Sensors::measured`]), lands the swing foot by position: at the planned
+//! touchdown, once the sole is within [`LANDING_HEIGHT_TOLERANCE_M`] of its foothold's height;
+//! the stabilizer then closes no loop on force-torque. A swing foot that cannot land within
+//! `late_touchdown_max_s` of the planned touchdown ends the stop with
+//! [`FaultCode::StopCouldNotLand`].
 
 use kinematics::ground::sequence_alignment;
 use kinematics::ground::{SupportPolygon, sole_corners};
@@ -28,7 +40,7 @@ use nalgebra::{DVector, Isometry3, UnitQuaternion, Vector2, Vector3};
 
 use super::DynamicPlan;
 use super::compliance::{TiltDamping, distribute, foot_damping, force_difference};
-use super::footsteps::{FEET, Support, SupportPhase};
+use super::footsteps::{FEET, Support, SupportPhase, SwingPlan};
 use super::sensing::{DcmEstimator, TiltRate, pressure_centre, tilted_com};
 use super::stabilizer::{Measured, Stabilizer};
 use super::swing::SwingTrajectory;
@@ -41,6 +53,10 @@ use crate::controller::trajectory::{PoseTrajectory, Profile};
 
 const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
 
+/// How far above its foothold's height a swing sole may be and still count as landed when no
+/// force-torque confirms it (m): the ground stops a foot commanded below it within this.
+pub(crate) const LANDING_HEIGHT_TOLERANCE_M: f64 = 0.015;
+
 /// What the dynamic gait reads besides the static machine's [`Feedback`] (estimated, world).
 pub(crate) struct Sensors<'a> {
     /// Ankle wrenches by `EndEffector` (see `Measurement::wrenches`).
@@ -51,6 +67,16 @@ pub(crate) struct Sensors<'a> {
     pub base_rotation: UnitQuaternion<f64>,
     /// The IMU's base orientation, if there is an IMU.
     pub imu: Option<UnitQuaternion<f64>>,
+    /// The tick runs on a measurement; false: on the last valid state advanced by the commands
+    /// (the measurement was invalid), so no force-torque or IMU reading is to be trusted.
+    pub measured: bool,
+}
+
+/// A controlled stop under way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Stop {
+    /// The feet's force-torque readings may confirm touchdowns and feed the stabilizer.
+    trust_force_sensors: bool,
 }
 
 /// The swing under way.
@@ -82,6 +108,10 @@ pub(crate) struct DynamicWalker {
     debounce: u32,
     cursor: usize,
     swing: Option<Swing>,
+    /// A controlled stop, once one began.
+    stop: Option<Stop>,
+    /// This tick lands swing feet by position, not by force-torque.
+    blind: bool,
     reaches: [Option<(PoseTrajectory, f64)>; 2],
     /// Released hands carried with the pelvis: their pose in its planar frame.
     carried: [Option<Isometry3<f64>>; 2],
@@ -121,6 +151,8 @@ impl DynamicWalker {
             debounce: 0,
             cursor: 0,
             swing: None,
+            stop: None,
+            blind: false,
             reaches: [None; 2],
             carried: [None; 2],
             stabilizer: Stabilizer::new(Default::default(), 1.0),
@@ -165,6 +197,60 @@ impl DynamicWalker {
     pub fn stop(&mut self) {
         self.running = false;
         self.started = false;
+        self.stop = None;
+    }
+
+    /// Ends the walk early with a controlled stop (see the module docs); with
+    /// `trust_force_sensors` false, touchdowns are confirmed by position and the stabilizer
+    /// closes no loop on force-torque until the walk ends. A stop already under way goes on,
+    /// and a distrust is kept. Returns false when no walk has begun (nothing moves that needs
+    /// stopping). Allocation-free.
+    pub fn stop_early(&mut self, trust_force_sensors: bool) -> bool {
+        if !self.started {
+            return false;
+        }
+        if let Some(stop) = &mut self.stop {
+            stop.trust_force_sensors &= trust_force_sensors;
+            return true;
+        }
+        self.stop = Some(Stop {
+            trust_force_sensors,
+        });
+        let Some(phase) = self.current_phase() else {
+            // Settling after the last phase: the walk is coming to rest already.
+            return true;
+        };
+        let (current, transition, now) = (self.phase, self.transition, self.clock);
+        let duration = self.plan().config.stop_double_support_s;
+        let to_world = self.to_world;
+        let plan = self
+            .sequence
+            .as_mut()
+            .and_then(|s| s.dynamic.as_deref_mut())
+            .expect("the walker runs only dynamic sequences");
+        let last = plan.footsteps.end_early(current, transition, now, duration);
+        let [Some(left), Some(right)] = last.feet else {
+            unreachable!("a double support stands on both feet");
+        };
+        let rest = ((to_world * left).translation.vector.xy()
+            + (to_world * right).translation.vector.xy())
+            / 2.0;
+        let from = match phase.support {
+            Support::Single(_) => phase.end_s(),
+            Support::Double { .. } => now,
+        };
+        plan.pattern.end_early(from, rest, duration);
+        // A lift-off that waited for its foot to unload is cancelled: no foot lifts any more.
+        if matches!(phase.support, Support::Double { .. }) {
+            self.late_s = None;
+        }
+        true
+    }
+
+    /// Whether the feet's force-torque readings are trusted (false during a stop that
+    /// distrusts them).
+    pub fn trusts_force_sensors(&self) -> bool {
+        self.stop.is_none_or(|stop| stop.trust_force_sensors)
     }
 
     /// The contact set, anchors and set-points of the last update.
@@ -228,10 +314,18 @@ impl DynamicWalker {
         } else {
             self.clock += dt;
         }
-        let progress = self.advance(feedback);
-        if progress != Progress::Running {
+        self.blind = !(sensors.measured && self.trusts_force_sensors());
+        let mut progress = self.advance(feedback);
+        if progress == Progress::Fault(FaultCode::MissedTouchdown) && self.stop.is_none() {
+            // The foot may stand on the ground with a sensor that does not say so: stop, and
+            // land it by position.
+            self.stop_early(false);
+            progress = Progress::Stopping(FaultCode::MissedTouchdown);
+        }
+        if matches!(progress, Progress::Done | Progress::Fault(_)) {
             self.running = false;
             self.started = false;
+            self.stop = None;
         }
         self.stabilize(feedback, sensors, dt);
         self.refresh_targets(&feedback.pelvis);
@@ -304,7 +398,7 @@ impl DynamicWalker {
             match phase.support {
                 Support::Single(swing) => {
                     let i = swing.foot as usize;
-                    if !self.targets.contacts[i] && self.touchdown_confirmed(feedback, &phase, i) {
+                    if !self.targets.contacts[i] && self.touchdown(feedback, &phase, &swing) {
                         self.land(swing.foot, feedback);
                     }
                     if self.clock < phase.end_s() {
@@ -313,11 +407,17 @@ impl DynamicWalker {
                     if !self.targets.contacts[i] {
                         self.clock = phase.end_s();
                         let late = self.late_s.get_or_insert(0.0);
-                        return if *late > self.plan().config.late_touchdown_max_s {
-                            Progress::Fault(FaultCode::MissedTouchdown)
-                        } else {
-                            Progress::Running
-                        };
+                        if *late <= self.plan().config.late_touchdown_max_s {
+                            return Progress::Running;
+                        }
+                        if self.stop.is_none() {
+                            return Progress::Fault(FaultCode::MissedTouchdown);
+                        }
+                        if !self.at_foothold(feedback, &swing) {
+                            return Progress::Fault(FaultCode::StopCouldNotLand);
+                        }
+                        // A stop lands a foot the ground holds up, whatever its sensor says.
+                        self.land(swing.foot, feedback);
                     }
                 }
                 Support::Double { lift_off } => {
@@ -325,7 +425,8 @@ impl DynamicWalker {
                         return Progress::Running;
                     }
                     if let Some(foot) = lift_off {
-                        let loaded = feedback.normal_forces[foot as usize] > self.release_force;
+                        let loaded = !self.blind
+                            && feedback.normal_forces[foot as usize] > self.release_force;
                         if loaded {
                             self.clock = phase.end_s();
                             let late = self.late_s.get_or_insert(0.0);
@@ -339,6 +440,22 @@ impl DynamicWalker {
             }
             self.next_phase(feedback);
         }
+    }
+
+    /// The swing foot has touched down: confirmed by force-torque, or by position on a tick
+    /// that is blind to force-torque.
+    fn touchdown(&mut self, feedback: &Feedback, phase: &SupportPhase, swing: &SwingPlan) -> bool {
+        if self.blind {
+            self.clock >= phase.end_s() && self.at_foothold(feedback, swing)
+        } else {
+            self.touchdown_confirmed(feedback, phase, swing.foot as usize)
+        }
+    }
+
+    /// The swing sole is no higher than [`LANDING_HEIGHT_TOLERANCE_M`] above its foothold.
+    fn at_foothold(&self, feedback: &Feedback, swing: &SwingPlan) -> bool {
+        let foothold = (self.to_world * swing.landing).translation.z;
+        feedback.poses[swing.foot as usize].translation.z - foothold <= LANDING_HEIGHT_TOLERANCE_M
     }
 
     /// Force-torque confirms the swing foot's contact (debounced), and the planned touchdown is
@@ -355,12 +472,17 @@ impl DynamicWalker {
         due && self.debounce >= self.config.touchdown_debounce_ticks
     }
 
-    /// Anchors a foot where it landed, at its contact surface's height.
+    /// Anchors a foot where it landed: at its contact surface's height when force-torque
+    /// confirmed the contact, exactly where it is when position did (the ground holds it there,
+    /// and leg odometry, then weighting both feet alike, must not see it move).
     fn land(&mut self, foot: EndEffector, feedback: &Feedback) {
         let e = foot as usize;
-        let planned = self.swing.map_or(feedback.poses[e].translation.z, |s| {
-            s.trajectory.landing().translation.z + self.plan().config.landing_depth_m
-        });
+        let planned = match self.swing {
+            Some(swing) if !self.blind => {
+                swing.trajectory.landing().translation.z + self.plan().config.landing_depth_m
+            }
+            _ => feedback.poses[e].translation.z,
+        };
         let mut anchor = feedback.poses[e];
         anchor.translation.z = planned;
         self.targets.contacts[e] = true;
@@ -480,9 +602,14 @@ impl DynamicWalker {
                 .zip(&sensors.ft_origins)
                 .map(|(f, o)| (&sensors.wrenches[*f as usize], o))
         };
-        let zmp = pressure_centre(foot_wrenches(), ground, self.touchdown_force);
+        let zmp = if self.blind {
+            None
+        } else {
+            pressure_centre(foot_wrenches(), ground, self.touchdown_force)
+        };
+        let imu = sensors.imu.filter(|_| sensors.measured);
         let mut com = feedback.com;
-        if let (true, Some(imu)) = (config.imu_tilt, sensors.imu) {
+        if let (true, Some(imu)) = (config.imu_tilt, imu) {
             let pivot = zmp.unwrap_or(reference.zmp);
             let pivot = Vector3::new(pivot.x, pivot.y, ground);
             com = tilted_com(&com, &pivot, &imu, &sensors.base_rotation);
@@ -499,7 +626,13 @@ impl DynamicWalker {
         self.targets.com_velocity = command.com_velocity;
         self.targets.balance = Balance::ComHeight(ground + self.plan().com_height);
         self.targets.torso_posture_weight = self.plan().config.torso_posture_weight;
-        self.comply(command.zmp, sensors, ground, dt);
+        if self.blind {
+            // No force-torque to comply with: the feet hold their anchors.
+            self.targets.contact_velocity = [[0.0; 6]; 2];
+            self.foot_turn = [Vector2::zeros(); 2];
+        } else {
+            self.comply(command.zmp, sensors, ground, dt);
+        }
         let offset = self.stabilizer.zmp_offset();
         let xy = |v: Vector2<f64>| [v.x, v.y];
         self.balance = BalanceStatus {
