@@ -201,6 +201,7 @@ pub fn status_json(status: &DaemonStatus) -> serde_json::Value {
         "left_foot": status.left_foot,
         "right_foot": status.right_foot,
         "fault": status.fault.as_str(),
+        "stop_s": status.stop_s,
         "adapter_link": status.link.name(),
         "adapter_holding": status.adapter_holding.is_set(),
         "ticks": status.ticks,
@@ -252,6 +253,12 @@ pub fn status_text(status: &DaemonStatus) -> String {
     );
     if !status.fault.is_empty() {
         text.push_str(&format!("\nlast fault: {}", status.fault));
+    }
+    if status.stop_s > 0.0 {
+        text.push_str(&format!(
+            "\nlast controlled stop: {:.2} s to rest on both feet",
+            status.stop_s
+        ));
     }
     text
 }

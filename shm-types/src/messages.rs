@@ -17,7 +17,7 @@ pub const WRENCH_ORDER: [&str; 4] = ["left_foot", "right_foot", "left_hand", "ri
 /// One sensor reading, adapter → daemon.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v2.SensorSample")]
+#[type_name("walk.v3.SensorSample")]
 pub struct SensorSample {
     /// Strictly increasing per adapter run.
     pub seq: u64,
@@ -53,7 +53,7 @@ wire_enum! {
 /// One joint command, daemon → adapter.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v2.JointCommand")]
+#[type_name("walk.v3.JointCommand")]
 pub struct JointCommand {
     /// Strictly increasing per daemon run.
     pub seq: u64,
@@ -196,7 +196,7 @@ wire_enum! {
 /// Percentiles of a latency distribution in microseconds.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("walk.v2.LatencySummary")]
+#[type_name("walk.v3.LatencySummary")]
 pub struct LatencySummary {
     /// Median.
     pub p50: f32,
@@ -213,7 +213,7 @@ pub const HISTOGRAM_BUCKETS: usize = 20;
 /// [2^b, 2^(b+1)) µs, the last bucket everything above.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("walk.v2.LogHistogram")]
+#[type_name("walk.v3.LogHistogram")]
 pub struct LogHistogram {
     /// Samples per bucket.
     pub counts: [u64; HISTOGRAM_BUCKETS],
@@ -229,7 +229,7 @@ impl LogHistogram {
 /// The daemon's state, published at a low rate (daemon → clients) and returned by `control`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v2.DaemonStatus")]
+#[type_name("walk.v3.DaemonStatus")]
 pub struct DaemonStatus {
     /// [`crate::PROTOCOL_VERSION`] of the daemon.
     pub protocol_version: u32,
@@ -259,6 +259,9 @@ pub struct DaemonStatus {
     pub right_foot: [f64; 7],
     /// The fault not yet acknowledged: its first cause, then what followed from it (empty: none).
     pub fault: FixedText<FAULT_TEXT>,
+    /// Duration of the current or last controlled stop (s): from the fault or request that began
+    /// it to rest on both feet (0: none since the last walk began).
+    pub stop_s: f64,
     /// Adapter link as seen by the watchdog.
     pub link: Code<LinkState>,
     /// Whether the adapter reports holding on its own.
@@ -306,6 +309,7 @@ impl DaemonStatus {
         left_foot: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
         right_foot: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
         fault: FixedText::EMPTY,
+        stop_s: 0.0,
         link: Code::from_raw(0),
         adapter_holding: Flag::NO,
         ticks: 0,
@@ -377,7 +381,7 @@ pub const FAULT_TEXT: usize = 256;
 /// [`DaemonStatus`] (world frame, translation xyz + quaternion xyzw of the sole frames).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("walk.v2.SimTruth")]
+#[type_name("walk.v3.SimTruth")]
 pub struct SimTruth {
     /// Strictly increasing per simulator run (a gap means a subscriber missed messages).
     pub seq: u64,
@@ -424,7 +428,7 @@ impl Default for SimTruth {
 /// The daemon's answer to a submitted sequence.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v2.SubmitReply")]
+#[type_name("walk.v3.SubmitReply")]
 pub struct SubmitReply {
     /// Whether the sequence was validated, prepared and started.
     pub accepted: Flag,
@@ -475,7 +479,7 @@ wire_enum! {
 /// A control request (client → daemon).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v2.ControlRequest")]
+#[type_name("walk.v3.ControlRequest")]
 pub struct ControlRequest {
     /// The command.
     pub command: Code<ControlCommand>,
@@ -499,7 +503,7 @@ impl Default for ControlRequest {
 /// The daemon's answer to a control request.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
-#[type_name("walk.v2.ControlReply")]
+#[type_name("walk.v3.ControlReply")]
 pub struct ControlReply {
     /// Whether the command was carried out.
     pub accepted: Flag,

@@ -4,9 +4,9 @@
 //!
 //! `walk-sim --inject` injects the fault `delay` seconds of simulated time after the walk's
 //! `--inject-step`-th lift-off, the delay a fraction of `[gait.dynamic] single_support_s`
-//! ([`Moment`]). The stop is timed by walkd's telemetry, to the tick: from the first tick that left
-//! `executing` to the first tick after it that is no longer a `controlled_stop` (zero for a gait
-//! that holds at once), each paired with the simulator's clock through the sample it answered.
+//! ([`Moment`]). The stop is timed by walkd itself, to the tick: its status's `stop_s`, the control
+//! periods from the fault or request that began the controlled stop to rest (zero for a gait that
+//! holds at once). The simulator's truth says whether the robot fell and where its feet ended.
 
 use std::ffi::OsString;
 
@@ -155,8 +155,8 @@ fn single_support_s(file: &ConfigFile) -> anyhow::Result<f64> {
 pub struct StopReport {
     /// The fault.
     pub injection: Injection,
-    /// Simulated time from the first tick that left `executing` to the end of its controlled
-    /// stop (s); `None` when the walk never left `executing` or the stop never ended.
+    /// walkd's time from the fault or request to the end of its controlled stop (s; 0: it held at
+    /// once); `None` when the walk went on to its end.
     pub stop_s: Option<f64>,
     /// The daemon's state at the end.
     pub ended: DaemonState,
@@ -181,11 +181,11 @@ impl StopReport {
     /// One line: the stop's time, tilt and end.
     pub fn describe(&self) -> String {
         format!(
-            "{}: {} stop {} tilt {:.3} rad, {}{}",
+            "{}: {} {} tilt {:.3} rad, {}{}",
             self.injection.label(),
             if self.success() { "ok" } else { "FAIL" },
             self.stop_s
-                .map_or_else(|| "none".to_owned(), |s| format!("{s:.2} s")),
+                .map_or_else(|| "walked on".to_owned(), |s| format!("stop {s:.2} s")),
             self.max_tilt_rad,
             self.ended.name(),
             match (self.fell, self.feet_down) {
@@ -199,17 +199,14 @@ impl StopReport {
 
 /// Judges `walk`, into which `injection` was injected.
 pub(crate) fn judge(injection: Injection, walk: &WatchedWalk) -> StopReport {
-    let (stop_start, stop_end) = stop_interval(&walk.state_changes);
-    let sim_time = |ns: u64| state_at(&walk.states, ns).map(|s| s.sim_time_s);
-    let stop_s = match (stop_start.and_then(sim_time), stop_end.and_then(sim_time)) {
-        (Some(start), Some(end)) => Some(end - start),
-        _ => None,
-    };
-    let from = stop_start.unwrap_or(walk.submitted_ns);
+    let ended = walk.last.state.get().unwrap_or(DaemonState::Executing);
+    let stopped = matches!(ended, DaemonState::Holding | DaemonState::Fault);
+    let faulted_at =
+        first_state_after(&walk.state_changes, DaemonState::Executing).unwrap_or(walk.submitted_ns);
     let after: Vec<&SimTruth> = walk
         .states
         .iter()
-        .filter(|s| s.timestamp_ns >= from)
+        .filter(|s| s.timestamp_ns >= faulted_at)
         .collect();
     let at_submission = state_at(&walk.states, walk.submitted_ns).or(walk.states.first());
     let feet_down = match (at_submission, walk.states.last()) {
@@ -221,29 +218,21 @@ pub(crate) fn judge(injection: Injection, walk: &WatchedWalk) -> StopReport {
     };
     StopReport {
         injection,
-        stop_s,
-        ended: walk.last.state.get().unwrap_or(DaemonState::Executing),
+        stop_s: stopped.then_some(walk.last.stop_s),
+        ended,
         feet_down,
         fell: walk.states.last().is_some_and(|s| s.fallen.is_set()),
         max_tilt_rad: after.iter().map(|s| s.tilt_rad).fold(0.0, f64::max),
     }
 }
 
-/// The sample times (ns) of the first tick that left `executing` and of the first tick after it
-/// that is no longer a controlled stop.
-fn stop_interval(changes: &[StateChange]) -> (Option<u64>, Option<u64>) {
-    let left = changes
+/// The sample time (ns) of the first tick after one in `state` that was in another state: when
+/// the walk left `executing`.
+fn first_state_after(changes: &[StateChange], state: DaemonState) -> Option<u64> {
+    changes
         .windows(2)
-        .position(|w| w[0].state == DaemonState::Executing && w[1].state != DaemonState::Executing)
-        .map(|i| i + 1);
-    let Some(start) = left else {
-        return (None, None);
-    };
-    let end = changes[start..]
-        .iter()
-        .find(|c| c.state != DaemonState::ControlledStop)
-        .map(|c| c.sample_timestamp_ns);
-    (Some(changes[start].sample_timestamp_ns), end)
+        .find(|w| w[0].state == state && w[1].state != state)
+        .map(|w| w[1].sample_timestamp_ns)
 }
 
 #[cfg(test)]
@@ -259,31 +248,16 @@ mod tests {
     }
 
     #[test]
-    fn a_stop_runs_from_leaving_executing_to_its_end() {
+    fn the_walk_left_executing_at_its_first_other_state() {
         let changes = [
             change(1, DaemonState::Holding),
             change(5, DaemonState::Executing),
             change(90, DaemonState::ControlledStop),
             change(700, DaemonState::Fault),
         ];
-        assert_eq!(stop_interval(&changes), (Some(90_000), Some(700_000)));
-    }
-
-    #[test]
-    fn an_immediate_hold_is_a_stop_of_no_time_and_a_walk_that_never_stopped_has_none() {
-        let held = [
-            change(5, DaemonState::Executing),
-            change(90, DaemonState::Fault),
-        ];
-        assert_eq!(stop_interval(&held), (Some(90_000), Some(90_000)));
-        let unfinished = [
-            change(5, DaemonState::Executing),
-            change(90, DaemonState::ControlledStop),
-        ];
-        assert_eq!(stop_interval(&unfinished), (Some(90_000), None));
-        assert_eq!(
-            stop_interval(&[change(5, DaemonState::Executing)]),
-            (None, None)
-        );
+        let left = first_state_after(&changes, DaemonState::Executing);
+        assert_eq!(left, Some(90_000));
+        let walking = [change(5, DaemonState::Executing)];
+        assert_eq!(first_state_after(&walking, DaemonState::Executing), None);
     }
 }

@@ -344,6 +344,7 @@ impl Controller {
         let previous = self.machine.load(seq);
         self.status.state = ControllerState::Executing;
         self.status.fault = FaultCode::None;
+        self.status.stop_s = 0.0;
         self.status.stance_index = 0;
         self.status.stance_count = self.machine.progress().1 as u32;
         Ok(previous)
@@ -482,6 +483,9 @@ impl Controller {
         out: &mut Command,
         measured: bool,
     ) -> bool {
+        if self.status.state == ControllerState::ControlledStop {
+            self.status.stop_s += dt;
+        }
         self.configuration.joints.copy_from_slice(measurement.q);
         if !self.world_ready {
             self.initialise_world(measurement);

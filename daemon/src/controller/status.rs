@@ -291,6 +291,8 @@ pub struct ControllerStatus {
     pub contacts: [bool; 4],
     /// The last fault (kept after leaving `Fault` until the next one).
     pub fault: FaultCode,
+    /// Duration of the current or last controlled stop (s; 0: none since the walk began).
+    pub stop_s: f64,
     /// Ticks since construction.
     pub ticks: u64,
     /// Iterations of the last QP solve.

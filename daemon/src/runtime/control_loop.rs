@@ -631,6 +631,7 @@ impl ControlLoop {
         status.left_foot = controller.left_foot;
         status.right_foot = controller.right_foot;
         status.fault = *self.faults.text();
+        status.stop_s = controller.stop_s;
         status.link = Code::new(self.link);
         status.adapter_holding = self.sample.adapter_holding;
         status.rejected_samples = self.gate.rejected();
