@@ -280,16 +280,24 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
             .flat_map(|request| injections.iter().map(move |injection| (request, injection)));
         for (i, (request, injection)) in runs.enumerate() {
             let pictured = args.snapshots.as_deref().filter(|_| i == 0);
-            let result = run_once(args, robot, &model, &config, request, *injection, pictured)
-                .with_context(|| {
-                    format!(
-                        "{robot} {} {} m run {}{}",
-                        request.affordances,
-                        request.distance,
-                        request.seed,
-                        injection.map_or_else(String::new, |i| format!(" ({})", i.label()))
-                    )
-                })?;
+            let result = run_once(
+                args,
+                robot,
+                &model,
+                &config,
+                (i, request),
+                *injection,
+                pictured,
+            )
+            .with_context(|| {
+                format!(
+                    "{robot} {} {} m run {}{}",
+                    request.affordances,
+                    request.distance,
+                    request.seed,
+                    injection.map_or_else(String::new, |i| format!(" ({})", i.label()))
+                )
+            })?;
             if !args.json {
                 eprintln!("{}", row(&result));
             }
@@ -333,14 +341,15 @@ fn plot_robot(dir: &Path, robot: &str, results: &[RunResult]) -> anyhow::Result<
     write_fig6(&file, &title, &result.trace, &result.balance)
 }
 
-/// One run: own processes on an own prefix, submit, record, stop; with `injection`, walk-sim
-/// injects that fault; with `pictured`, the snapshots of `--snapshots` go there.
+/// Run number `slot` of a robot: own processes on an own prefix, submit, record, stop; with
+/// `injection`, walk-sim injects that fault; with `pictured`, the snapshots of `--snapshots` go
+/// there.
 fn run_once(
     args: &EvaluateArgs,
     robot: &str,
     model: &Arc<Robot>,
     config: &Path,
-    request: &WalkRequest,
+    (slot, request): (usize, &WalkRequest),
     injection: Option<Injection>,
     pictured: Option<&Path>,
 ) -> anyhow::Result<RunResult> {
@@ -353,7 +362,9 @@ fn run_once(
         seed: run,
     } = request;
     let sequence = stance::synthetic_walk(model, &params, request)?;
-    let prefix = format!("walk-eval/{robot}/{}/{run}", std::process::id());
+    // One prefix a run: the runs of one walk with different faults follow each other, and a new
+    // walkd must not meet the services of the last one while they are being torn down.
+    let prefix = format!("walk-eval/{robot}/{}/{slot}", std::process::id());
     let launch = Launch {
         bin_dir: executable_dir()?,
         config: config.to_owned(),
