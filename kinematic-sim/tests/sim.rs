@@ -222,7 +222,8 @@ fn a_dynamic_walk_is_judged_by_the_zmp_of_its_com_motion() {
         for &j in &ankles {
             q[j] += swing;
         }
-        sim.step(q.as_slice(), q.as_slice(), dt).unwrap();
+        let rate = (&q - sim.measurement().q.clone()) / dt;
+        sim.step(q.as_slice(), rate.as_slice(), dt).unwrap();
         let m = sim.measurement();
         coms.push(m.com);
         if coms.len() < 3 {
@@ -269,11 +270,12 @@ fn re_placing_the_base_between_inconsistent_feet_is_not_motion_for_the_zmp() {
     let dt = 0.001;
     let mut worst_offset: f64 = 0.0;
     for k in 0..1500 {
+        let mut rate = nalgebra::DVector::zeros(q.len());
         if k < 100 {
-            q[hip] += 4e-6;
-            q[ankle] -= 4e-6;
+            (rate[hip], rate[ankle]) = (4e-6 / dt, -4e-6 / dt);
+            q += &rate * dt;
         }
-        sim.step(q.as_slice(), q.as_slice(), dt).unwrap();
+        sim.step(q.as_slice(), rate.as_slice(), dt).unwrap();
         let m = sim.measurement();
         assert_eq!(m.contacts, [true, true, false, false], "step {k}");
         assert!(
@@ -297,4 +299,54 @@ fn re_placing_the_base_between_inconsistent_feet_is_not_motion_for_the_zmp() {
         worst_offset < 1e-6,
         "holding still, the ZMP stays under the CoM: {worst_offset} m off"
     );
+}
+
+#[test]
+fn a_setpoint_applied_again_is_a_missed_command_not_a_stop() {
+    // Over processes in real time a command that comes a period late (the controller skipped a
+    // tick) leaves the adapter applying its last setpoint again. The ideal servos then stand
+    // still for a step and go on; counted as motion, that stop at walking pace decelerates the
+    // rigid robot within one step and its ZMP left the feet by 0.1-1 m (a `walkctl demo
+    // --gait dynamic --physics kinematic` in real time "fell" at every lost tick). A controller
+    // that moves never sends the same setpoint twice (each one moves on by its rate), so a
+    // setpoint given again with a non-zero rate is a missed command: the joints hold and the
+    // ZMP's motion history skips the step.
+    let robot = robot("jvrc1");
+    let options = SimOptions {
+        judge_by_zmp: true,
+        ..SimOptions::default()
+    };
+    let mut sim = KinematicSim::with_options(robot.clone(), robot.standing.clone(), options)
+        .expect("standing");
+    // Both ankles pitch the body forward, the rate rising smoothly to 0.1 rad/s over 0.4 s (the
+    // CoM then moves at about 0.09 m/s), as the controller would command it.
+    let ankles = [
+        leg_joint(&robot, true, "ankle_p"),
+        leg_joint(&robot, false, "ankle_p"),
+    ];
+    let dt = 0.002;
+    let mut q = robot.standing.joints.clone();
+    let mut rate = nalgebra::DVector::zeros(q.len());
+    for k in 0..300 {
+        let t = f64::from(k) * dt;
+        let missed = k == 250;
+        if !missed {
+            let speed = 0.1 * (1.0 - (std::f64::consts::PI * (t / 0.4).min(1.0)).cos()) / 2.0;
+            for &j in &ankles {
+                rate[j] = speed;
+            }
+            q += &rate * dt;
+        }
+        let before = sim.measurement().q.clone();
+        sim.step(q.as_slice(), rate.as_slice(), dt).unwrap();
+        let m = sim.measurement();
+        if missed {
+            assert_eq!(m.q, before, "the joints hold through a missed command");
+        }
+        assert!(
+            m.safety.stability_margin > 0.01,
+            "step {k}: ZMP margin {} m",
+            m.safety.stability_margin
+        );
+    }
 }
