@@ -40,6 +40,25 @@ fn leg_joint(robot: &Robot, prefix_left: bool, contains: &str) -> usize {
         .expect("leg joint exists")
 }
 
+/// A simulator of `robot` standing that judges by the ZMP, its CoM acceleration filtered with
+/// time constant `zmp_filter_s`.
+fn judged_by_zmp(robot: &Arc<Robot>, zmp_filter_s: f64) -> KinematicSim {
+    let options = SimOptions {
+        judge_by_zmp: true,
+        zmp_filter_s,
+        ..SimOptions::default()
+    };
+    KinematicSim::with_options(robot.clone(), robot.standing.clone(), options).expect("standing")
+}
+
+/// Both ankle pitch joints (left, right).
+fn ankle_pitches(robot: &Robot) -> [usize; 2] {
+    [
+        leg_joint(robot, true, "ankle_p"),
+        leg_joint(robot, false, "ankle_p"),
+    ]
+}
+
 /// The feet's ground wrenches summed at the world origin: the moments about x and y that put
 /// their resultant at the centre of pressure (`p_y = m_x / F_z`, `p_x = m_y / F_z`), and the
 /// normal force `F_z`.
@@ -202,18 +221,9 @@ fn moving_every_joint_in_single_support_keeps_the_stance_foot_in_place() {
 #[test]
 fn a_dynamic_walk_is_judged_by_the_zmp_of_its_com_motion() {
     let robot = robot("jvrc1");
-    let options = SimOptions {
-        judge_by_zmp: true,
-        zmp_filter_s: 0.0,
-        ..SimOptions::default()
-    };
-    let mut sim = KinematicSim::with_options(robot.clone(), robot.standing.clone(), options)
-        .expect("standing");
+    let mut sim = judged_by_zmp(&robot, 0.0);
     // Both ankles pitch the body back and forth at 1.5 Hz: the CoM accelerates along x.
-    let ankles = [
-        leg_joint(&robot, true, "ankle_p"),
-        leg_joint(&robot, false, "ankle_p"),
-    ];
+    let ankles = ankle_pitches(&robot);
     let dt = 0.002;
     let mut coms = Vec::new();
     for k in 0..300 {
@@ -256,12 +266,7 @@ fn re_placing_the_base_between_inconsistent_feet_is_not_motion_for_the_zmp() {
     // support. Here the right foot is slid 0.3 mm sideways while both feet are anchored, then
     // the robot holds still: nothing moves but the base between the two placements.
     let robot = robot("jvrc1");
-    let options = SimOptions {
-        judge_by_zmp: true,
-        ..SimOptions::default()
-    };
-    let mut sim = KinematicSim::with_options(robot.clone(), robot.standing.clone(), options)
-        .expect("standing");
+    let mut sim = judged_by_zmp(&robot, SimOptions::default().zmp_filter_s);
     let (hip, ankle) = (
         leg_joint(&robot, false, "hip_r"),
         leg_joint(&robot, false, "ankle_r"),
@@ -312,18 +317,10 @@ fn a_setpoint_applied_again_is_a_missed_command_not_a_stop() {
     // setpoint given again with a non-zero rate is a missed command: the joints hold and the
     // ZMP's motion history skips the step.
     let robot = robot("jvrc1");
-    let options = SimOptions {
-        judge_by_zmp: true,
-        ..SimOptions::default()
-    };
-    let mut sim = KinematicSim::with_options(robot.clone(), robot.standing.clone(), options)
-        .expect("standing");
+    let mut sim = judged_by_zmp(&robot, SimOptions::default().zmp_filter_s);
     // Both ankles pitch the body forward, the rate rising smoothly to 0.1 rad/s over 0.4 s (the
     // CoM then moves at about 0.09 m/s), as the controller would command it.
-    let ankles = [
-        leg_joint(&robot, true, "ankle_p"),
-        leg_joint(&robot, false, "ankle_p"),
-    ];
+    let ankles = ankle_pitches(&robot);
     let dt = 0.002;
     let mut q = robot.standing.joints.clone();
     let mut rate = nalgebra::DVector::zeros(q.len());
