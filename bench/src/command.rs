@@ -12,7 +12,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
-use daemon::controller::{Controller, ControllerConfig, ControllerState, GaitConfig, SolverKind};
+use daemon::controller::{Controller, ControllerConfig, ControllerState, SolverKind};
 use daemon::qp::{ClarabelSolver, DenseActiveSetSolver, QpSolver, export_json};
 use hdrhistogram::Histogram;
 use kinematics::ConfigFile;
@@ -141,7 +141,7 @@ fn run(args: &BenchArgs) -> anyhow::Result<bool> {
     let gait = Gait::chosen_or_configured(args.gait, &file)?;
     let params = PostProcessParams::from_config_for(&file, gait)?;
     let config = ControllerConfig::from_config(&file)?;
-    let gaits = kinematic_gaits(GaitConfig::from_config(&file)?);
+    let gaits = kinematic_gaits(&file)?;
     let rate_hz = match (args.rate_hz, file.section("runtime")) {
         (Some(rate), _) => rate,
         (None, Some(section)) => {

@@ -10,6 +10,7 @@ use daemon::controller::{
     SolverKind,
 };
 use kinematic_sim::{KinematicSim, SafetySummary, SimMeasurement, SimOptions};
+use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use stance::PostProcessedSequence;
 
@@ -43,16 +44,18 @@ impl Default for WalkOptions {
     }
 }
 
-/// A robot's `[gait]` tuning for the kinematic simulator: the stabilizer parts that act on
-/// forces and inertia (foot damping, tilt damping) switched off. An ideal kinematic robot has
-/// neither, its synthetic centre of pressure follows the commanded motion, and with them on the
-/// kinematic dynamic walk's ZMP leaves the support (docs/controller.md).
-pub fn kinematic_gaits(mut gaits: GaitConfig) -> GaitConfig {
-    if let Some(dynamic) = &mut gaits.dynamic {
-        dynamic.stabilizer.foot_damping = false;
-        dynamic.stabilizer.tilt_damping = false;
+/// A robot's `[gait]` tuning for the kinematic simulator: its config with
+/// [`client::process::kinematic_sim_settings`] applied, the values walkd runs with against
+/// `walk-sim --physics kinematic`, so both loops walk the same controller. Those switch off the
+/// stabilizer parts that act through contact compliance (foot damping, tilt damping): an ideal
+/// kinematic robot is rigid, its synthetic centre of pressure follows the commanded motion, and
+/// with them on the kinematic dynamic walk's ZMP leaves the support (docs/controller.md).
+pub fn kinematic_gaits(file: &ConfigFile) -> anyhow::Result<GaitConfig> {
+    let mut file = file.clone();
+    for setting in client::process::kinematic_sim_settings(&file) {
+        file.set(setting)?;
     }
-    gaits
+    Ok(GaitConfig::from_config(&file)?)
 }
 
 /// One closed-loop tick, handed to the observer after the simulator stepped.

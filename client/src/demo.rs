@@ -20,7 +20,7 @@ use crate::daemon_client::connect_when_fresh;
 use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
 use crate::evaluate::truth::judged_outcome;
 use crate::evaluate::watch::{WatchOptions, WatchedWalk, watch_walk};
-use crate::process::{Launch, Processes, executable_dir};
+use crate::process::{Launch, PlantArgs, Processes, executable_dir};
 use crate::watch::StanceProgress;
 
 /// The robots with a vendored config.
@@ -248,8 +248,11 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
             rate_hz: args.rate_hz,
             urdf: args.urdf.clone(),
         };
-        children.0.push(launch.walkd(&[], &[])?);
-        children.0.push(launch.walk_sim(args.physics, &[])?);
+        let plant = PlantArgs::new(args.physics, gait, &file);
+        children.0.push(launch.walkd(&plant.walkd, &[])?);
+        children
+            .0
+            .push(launch.walk_sim(args.physics, &plant.walk_sim)?);
     }
     let client = connect_when_fresh(&prefix, &children.0, Duration::from_secs(20))?;
     let progress = (!args.json).then(StanceProgress::new);

@@ -47,7 +47,7 @@ use stance::poses::FEET;
 use stance::{AffordanceSet, Gait, PostProcessedSequence, WalkRequest};
 
 use crate::daemon_client::connect_when_fresh;
-use crate::process::{Launch, executable_dir};
+use crate::process::{Launch, PlantArgs, executable_dir};
 use stop::{InjectArgs, Injection, StopReport};
 use watch::{WatchOptions, watch_walk};
 
@@ -374,7 +374,8 @@ fn run_once(
         urdf: args.urdf.clone(),
     };
     let frames = pictured.map(|dir| dir.join(format!("frames-{robot}")));
-    let mut sim_args: Vec<std::ffi::OsString> = Vec::new();
+    let plant = PlantArgs::new(args.physics, gait, &file);
+    let mut sim_args = plant.walk_sim;
     if let Some(frames) = &frames {
         let _ = std::fs::remove_dir_all(frames);
         // The side camera looks at the middle of the walk (it starts at x = 0 along +x).
@@ -386,7 +387,10 @@ fn run_once(
         sim_args.extend(injection.sim_args());
     }
     let processes = [
-        launch.walkd(&["--no-lock-memory"], &[])?,
+        launch.walkd(
+            &[&["--no-lock-memory"], plant.walkd.as_slice()].concat(),
+            &[],
+        )?,
         launch.walk_sim(args.physics, &sim_args)?,
     ];
     let client = connect_when_fresh(&prefix, &processes, Duration::from_secs(30))?;

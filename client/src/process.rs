@@ -12,8 +12,10 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
+use kinematics::ConfigFile;
 use shm_types::ClockMode;
 use shm_types::process::Physics;
+use stance::Gait;
 
 /// How long a child may take to exit after SIGTERM before it is killed.
 pub const STOP_TIMEOUT: Duration = Duration::from_secs(5);
@@ -255,10 +257,89 @@ impl Launch {
     }
 }
 
+/// The config values a controller runs with against the kinematic simulator, as `section.key=value`
+/// assignments (`walkd --set`; `walk_bench::kinematic_gaits` applies them in process). Its robot
+/// is rigid: the stabilizer parts that act through contact compliance, foot damping and tilt
+/// damping, turn its whole body instead of shifting its centres of pressure, and their loops
+/// diverge (docs/controller.md, "The kinematic simulator and dynamic walks"). None for a config
+/// without `[gait.dynamic]`: it has no stabilizer, and setting these keys would create one.
+pub fn kinematic_sim_settings(file: &ConfigFile) -> &'static [&'static str] {
+    let dynamic = file
+        .section("gait")
+        .is_some_and(|gait| gait.get("dynamic").is_some());
+    if dynamic {
+        &[
+            "gait.dynamic.stabilizer.foot_damping=false",
+            "gait.dynamic.stabilizer.tilt_damping=false",
+        ]
+    } else {
+        &[]
+    }
+}
+
+/// What `walkd` and `walk-sim` take beyond [`Launch::common_args`] to walk one gait on one
+/// simulator as `walk-bench` does in process: against the kinematic simulator, walkd without
+/// the stabilizer parts its rigid robot cannot use, and for the dynamic gait walk-sim judging
+/// by the ZMP.
+#[derive(Debug, Clone, Default)]
+pub struct PlantArgs {
+    /// Extra arguments of `walkd`.
+    pub walkd: Vec<&'static str>,
+    /// Extra arguments of `walk-sim`.
+    pub walk_sim: Vec<OsString>,
+}
+
+impl PlantArgs {
+    /// The arguments for walks of `gait` with the config `file` on `physics`.
+    pub fn new(physics: Physics, gait: Gait, file: &ConfigFile) -> Self {
+        let mut args = Self::default();
+        if physics == Physics::Kinematic {
+            for setting in kinematic_sim_settings(file) {
+                args.walkd.extend(["--set", setting]);
+            }
+            if gait == Gait::Dynamic {
+                args.walk_sim.push("--judge-by-zmp".into());
+            }
+        }
+        args
+    }
+}
+
 /// The directory of the running executable (where cargo puts all the binaries).
 pub fn executable_dir() -> anyhow::Result<PathBuf> {
     Ok(std::env::current_exe()?
         .parent()
         .context("the executable has no directory")?
         .to_owned())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_kinematic_simulator_gets_plant_arguments() {
+        let parse = |text: &str| ConfigFile::parse(text, Path::new("robot.toml")).unwrap();
+        let dynamic = parse("[gait.dynamic]\nsingle_support_s = 0.6\n");
+        let walkd = [
+            "--set",
+            "gait.dynamic.stabilizer.foot_damping=false",
+            "--set",
+            "gait.dynamic.stabilizer.tilt_damping=false",
+        ];
+        let walk = PlantArgs::new(Physics::Kinematic, Gait::Dynamic, &dynamic);
+        assert_eq!(walk.walkd, walkd);
+        assert_eq!(walk.walk_sim, ["--judge-by-zmp"]);
+        // A static walk is judged by the CoM; walkd is set up the same.
+        let walk = PlantArgs::new(Physics::Kinematic, Gait::Static, &dynamic);
+        assert_eq!(walk.walkd, walkd);
+        assert!(walk.walk_sim.is_empty());
+        // Without [gait.dynamic] there is no stabilizer to tune, and none is created.
+        let static_only = parse("[gait]\ndefault = \"static\"\n");
+        let walk = PlantArgs::new(Physics::Kinematic, Gait::Static, &static_only);
+        assert!(walk.walkd.is_empty());
+        // MuJoCo's robot is compliant and its physics judges itself.
+        let walk = PlantArgs::new(Physics::Mujoco, Gait::Dynamic, &dynamic);
+        assert!(walk.walkd.is_empty() && walk.walk_sim.is_empty());
+    }
 }

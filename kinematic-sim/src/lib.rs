@@ -281,6 +281,8 @@ pub struct KinematicSim {
     com_acceleration: Vector3<f64>,
     /// Where the ground reaction acted in the last step (see `resultant`).
     support_point: Vector3<f64>,
+    /// The last setpoint applied (joint angles, rates), to recognise one given again.
+    setpoint: (DVector<f64>, DVector<f64>),
 }
 
 impl KinematicSim {
@@ -298,6 +300,7 @@ impl KinematicSim {
         let mut kinematics = Kinematics::new(&robot.model);
         kinematics.update(&robot.model, &initial);
         let measurement = SimMeasurement::at_rest(&initial, kinematics.com());
+        let setpoint = (initial.joints.clone(), DVector::zeros(initial.joints.len()));
         let mut sim = Self {
             robot,
             options,
@@ -313,6 +316,7 @@ impl KinematicSim {
             replacement: Vector3::zeros(),
             com_acceleration: Vector3::zeros(),
             support_point: Vector3::zeros(),
+            setpoint,
         };
         sim.support_point = sim.kinematics.com();
         let mut lowest = f64::INFINITY;
@@ -326,7 +330,7 @@ impl KinematicSim {
         if sim.anchors.iter().all(Option::is_none) {
             return Err(SimError::NotStanding { lowest_m: lowest });
         }
-        sim.finish_step(0, 0.0);
+        sim.finish_step(0, Some(0.0));
         Ok(sim)
     }
 
@@ -337,6 +341,18 @@ impl KinematicSim {
 
     fn check_command(&self, field: &'static str, values: &[f64]) -> Result<(), SimError> {
         Ok(check_joint_vector(&self.robot.model, field, values)?)
+    }
+
+    /// Whether the setpoint `q_des` / `qd_des` is the last one given again with a non-zero rate:
+    /// a command that did not come (see `Simulator::step`). Remembers it as the last one.
+    fn missed_command(&mut self, q_des: &[f64], qd_des: &[f64]) -> bool {
+        let (q, qd) = &mut self.setpoint;
+        let missed = q.as_slice() == q_des
+            && qd.as_slice() == qd_des
+            && qd_des.iter().any(|rate| *rate != 0.0);
+        q.copy_from_slice(q_des);
+        qd.copy_from_slice(qd_des);
+        missed
     }
 
     fn pose(&self, e: EndEffector) -> Isometry3<f64> {
@@ -445,24 +461,20 @@ impl KinematicSim {
     }
 
     /// The point the ground reaction acts at (the CoM's ground projection, or the ZMP of its
-    /// motion with `judge_by_zmp`) and the total normal force, in the state after a step of `dt`.
-    fn resultant(&mut self, com: &Vector3<f64>, dt: f64) -> (Vector3<f64>, f64) {
+    /// motion with `judge_by_zmp`) and the total normal force, in the state after a step of
+    /// `elapsed` (`None`: a missed command, which the motion history skips).
+    fn resultant(&mut self, com: &Vector3<f64>, elapsed: Option<f64>) -> (Vector3<f64>, f64) {
         let mass = self.robot.model.total_mass();
         if !self.options.judge_by_zmp {
             return (*com, mass * GRAVITY);
         }
-        let history = self.com_history;
-        let velocity = match history {
-            Some((last, _)) if dt > 0.0 => Some((com - self.replacement - last) / dt),
-            _ => None,
+        let accelerating = match elapsed {
+            Some(dt) => self.track_acceleration(com, dt),
+            None => matches!(self.com_history, Some((_, Some(_)))),
         };
-        self.com_history = Some((*com, velocity));
-        let (Some(velocity), Some((_, Some(previous_velocity)))) = (velocity, history) else {
+        if !accelerating {
             return (*com, mass * GRAVITY);
-        };
-        let raw = (velocity - previous_velocity) / dt;
-        let blend = dt / (self.options.zmp_filter_s + dt);
-        self.com_acceleration += (raw - self.com_acceleration) * blend;
+        }
         let acceleration = self.com_acceleration;
         let height = com.z - self.options.ground_height;
         // The ground carries m (g + z̈); with none to carry (the CoM falling faster than g) the
@@ -476,10 +488,29 @@ impl KinematicSim {
         (zmp, mass * support)
     }
 
-    /// Forces, metrics and the measurement record of the new state, `dt` after the last.
-    fn finish_step(&mut self, limit_violations: usize, dt: f64) {
+    /// Records the CoM `com` reached in a step of `dt` and low-pass filters its acceleration
+    /// (finite differences, less the base re-placement); false until two velocities are known.
+    fn track_acceleration(&mut self, com: &Vector3<f64>, dt: f64) -> bool {
+        let history = self.com_history;
+        let velocity = match history {
+            Some((last, _)) if dt > 0.0 => Some((com - self.replacement - last) / dt),
+            _ => None,
+        };
+        self.com_history = Some((*com, velocity));
+        let (Some(velocity), Some((_, Some(previous_velocity)))) = (velocity, history) else {
+            return false;
+        };
+        let raw = (velocity - previous_velocity) / dt;
+        let blend = dt / (self.options.zmp_filter_s + dt);
+        self.com_acceleration += (raw - self.com_acceleration) * blend;
+        true
+    }
+
+    /// Forces, metrics and the measurement record of the new state, `elapsed` after the last
+    /// (`None`: a missed command, see `resultant`).
+    fn finish_step(&mut self, limit_violations: usize, elapsed: Option<f64>) {
         let com = self.kinematics.com();
-        let (support_point, weight) = self.resultant(&com, dt);
+        let (support_point, weight) = self.resultant(&com, elapsed);
         self.support_point = support_point;
         let shares = self.lever_shares(&support_point);
         let mut loads = [0.0; 2];

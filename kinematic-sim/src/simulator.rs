@@ -35,9 +35,15 @@ pub trait Simulator {
     fn time(&self) -> f64;
 }
 
-/// Joints follow the command ideally (a perfect position servo, stopped at the limits; `qd_des`
-/// is checked but not needed), the base follows the feet in contact, contacts, forces and
-/// metrics are updated each step.
+/// Joints follow the command ideally (a perfect position servo, stopped at the limits), the base
+/// follows the feet in contact, contacts, forces and metrics are updated each step.
+///
+/// A controller that moves the robot never sends the same setpoint twice: each one moves on by
+/// its rate `qd_des`. One given again with a non-zero rate is a command that did not come (an
+/// adapter in real time applies its last setpoint again while the controller is a period late).
+/// The joints hold, as an ideal servo does, but the ZMP's motion history skips the step: a real
+/// robot's servos ride through one missing setpoint, while the ideal ones stop dead, which at
+/// walking pace put the ZMP 0.1-1 m off the feet for that one step.
 impl Simulator for KinematicSim {
     type Error = SimError;
 
@@ -51,6 +57,7 @@ impl Simulator for KinematicSim {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(SimError::BadTimeStep(dt));
         }
+        let missed = self.missed_command(q_des, qd_des);
         let mut violations = 0;
         let limits = self.robot.model.joint_limits();
         for (j, (&target, limit)) in q_des.iter().zip(limits).enumerate() {
@@ -63,7 +70,7 @@ impl Simulator for KinematicSim {
         }
         self.place_base();
         self.update_contacts();
-        self.finish_step(violations, dt);
+        self.finish_step(violations, (!missed).then_some(dt));
         self.time += dt;
         Ok(())
     }

@@ -40,6 +40,25 @@ fn leg_joint(robot: &Robot, prefix_left: bool, contains: &str) -> usize {
         .expect("leg joint exists")
 }
 
+/// A simulator of `robot` standing that judges by the ZMP, its CoM acceleration filtered with
+/// time constant `zmp_filter_s`.
+fn judged_by_zmp(robot: &Arc<Robot>, zmp_filter_s: f64) -> KinematicSim {
+    let options = SimOptions {
+        judge_by_zmp: true,
+        zmp_filter_s,
+        ..SimOptions::default()
+    };
+    KinematicSim::with_options(robot.clone(), robot.standing.clone(), options).expect("standing")
+}
+
+/// Both ankle pitch joints (left, right).
+fn ankle_pitches(robot: &Robot) -> [usize; 2] {
+    [
+        leg_joint(robot, true, "ankle_p"),
+        leg_joint(robot, false, "ankle_p"),
+    ]
+}
+
 /// The feet's ground wrenches summed at the world origin: the moments about x and y that put
 /// their resultant at the centre of pressure (`p_y = m_x / F_z`, `p_x = m_y / F_z`), and the
 /// normal force `F_z`.
@@ -202,18 +221,9 @@ fn moving_every_joint_in_single_support_keeps_the_stance_foot_in_place() {
 #[test]
 fn a_dynamic_walk_is_judged_by_the_zmp_of_its_com_motion() {
     let robot = robot("jvrc1");
-    let options = SimOptions {
-        judge_by_zmp: true,
-        zmp_filter_s: 0.0,
-        ..SimOptions::default()
-    };
-    let mut sim = KinematicSim::with_options(robot.clone(), robot.standing.clone(), options)
-        .expect("standing");
+    let mut sim = judged_by_zmp(&robot, 0.0);
     // Both ankles pitch the body back and forth at 1.5 Hz: the CoM accelerates along x.
-    let ankles = [
-        leg_joint(&robot, true, "ankle_p"),
-        leg_joint(&robot, false, "ankle_p"),
-    ];
+    let ankles = ankle_pitches(&robot);
     let dt = 0.002;
     let mut coms = Vec::new();
     for k in 0..300 {
@@ -222,7 +232,8 @@ fn a_dynamic_walk_is_judged_by_the_zmp_of_its_com_motion() {
         for &j in &ankles {
             q[j] += swing;
         }
-        sim.step(q.as_slice(), q.as_slice(), dt).unwrap();
+        let rate = (&q - sim.measurement().q.clone()) / dt;
+        sim.step(q.as_slice(), rate.as_slice(), dt).unwrap();
         let m = sim.measurement();
         coms.push(m.com);
         if coms.len() < 3 {
@@ -255,12 +266,7 @@ fn re_placing_the_base_between_inconsistent_feet_is_not_motion_for_the_zmp() {
     // support. Here the right foot is slid 0.3 mm sideways while both feet are anchored, then
     // the robot holds still: nothing moves but the base between the two placements.
     let robot = robot("jvrc1");
-    let options = SimOptions {
-        judge_by_zmp: true,
-        ..SimOptions::default()
-    };
-    let mut sim = KinematicSim::with_options(robot.clone(), robot.standing.clone(), options)
-        .expect("standing");
+    let mut sim = judged_by_zmp(&robot, SimOptions::default().zmp_filter_s);
     let (hip, ankle) = (
         leg_joint(&robot, false, "hip_r"),
         leg_joint(&robot, false, "ankle_r"),
@@ -269,11 +275,12 @@ fn re_placing_the_base_between_inconsistent_feet_is_not_motion_for_the_zmp() {
     let dt = 0.001;
     let mut worst_offset: f64 = 0.0;
     for k in 0..1500 {
+        let mut rate = nalgebra::DVector::zeros(q.len());
         if k < 100 {
-            q[hip] += 4e-6;
-            q[ankle] -= 4e-6;
+            (rate[hip], rate[ankle]) = (4e-6 / dt, -4e-6 / dt);
+            q += &rate * dt;
         }
-        sim.step(q.as_slice(), q.as_slice(), dt).unwrap();
+        sim.step(q.as_slice(), rate.as_slice(), dt).unwrap();
         let m = sim.measurement();
         assert_eq!(m.contacts, [true, true, false, false], "step {k}");
         assert!(
@@ -297,4 +304,46 @@ fn re_placing_the_base_between_inconsistent_feet_is_not_motion_for_the_zmp() {
         worst_offset < 1e-6,
         "holding still, the ZMP stays under the CoM: {worst_offset} m off"
     );
+}
+
+#[test]
+fn a_setpoint_applied_again_is_a_missed_command_not_a_stop() {
+    // Over processes in real time a command that comes a period late (the controller skipped a
+    // tick) leaves the adapter applying its last setpoint again. The ideal servos then stand
+    // still for a step and go on; counted as motion, that stop at walking pace decelerates the
+    // rigid robot within one step and its ZMP left the feet by 0.1-1 m (a `walkctl demo
+    // --gait dynamic --physics kinematic` in real time "fell" at every lost tick). A controller
+    // that moves never sends the same setpoint twice (each one moves on by its rate), so a
+    // setpoint given again with a non-zero rate is a missed command: the joints hold and the
+    // ZMP's motion history skips the step.
+    let robot = robot("jvrc1");
+    let mut sim = judged_by_zmp(&robot, SimOptions::default().zmp_filter_s);
+    // Both ankles pitch the body forward, the rate rising smoothly to 0.1 rad/s over 0.4 s (the
+    // CoM then moves at about 0.09 m/s), as the controller would command it.
+    let ankles = ankle_pitches(&robot);
+    let dt = 0.002;
+    let mut q = robot.standing.joints.clone();
+    let mut rate = nalgebra::DVector::zeros(q.len());
+    for k in 0..300 {
+        let t = f64::from(k) * dt;
+        let missed = k == 250;
+        if !missed {
+            let speed = 0.1 * (1.0 - (std::f64::consts::PI * (t / 0.4).min(1.0)).cos()) / 2.0;
+            for &j in &ankles {
+                rate[j] = speed;
+            }
+            q += &rate * dt;
+        }
+        let before = sim.measurement().q.clone();
+        sim.step(q.as_slice(), rate.as_slice(), dt).unwrap();
+        let m = sim.measurement();
+        if missed {
+            assert_eq!(m.q, before, "the joints hold through a missed command");
+        }
+        assert!(
+            m.safety.stability_margin > 0.01,
+            "step {k}: ZMP margin {} m",
+            m.safety.stability_margin
+        );
+    }
 }

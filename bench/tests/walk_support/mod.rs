@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use daemon::controller::{Controller, ControllerConfig, Gait, GaitConfig, Phase, SolverKind};
 use kinematic_sim::{KinematicSim, SimOptions};
+use kinematics::ConfigFile;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Translation3};
@@ -30,9 +31,10 @@ pub fn robot(name: &str) -> Arc<Robot> {
 /// stabilizer that need forces and inertia (foot damping, tilt damping) switched off, as an ideal
 /// kinematic robot has neither: its synthetic centre of pressure follows the commanded motion.
 pub fn kinematic_gait_config(name: &str) -> GaitConfig {
-    let gaits = GaitConfig::from_config_file(&config_path(name)).expect("gait config parses");
+    let file = ConfigFile::load(&config_path(name)).expect("vendored config loads");
+    let gaits = walk_bench::kinematic_gaits(&file).expect("gait config parses");
     assert!(gaits.dynamic.is_some(), "{name} has a dynamic gait");
-    walk_bench::kinematic_gaits(gaits)
+    gaits
 }
 
 /// The `[controller]` section of `name`'s config.

@@ -77,6 +77,11 @@ pub struct DaemonArgs {
     /// Busy-wait time around each expected sample (µs), overriding `[runtime] spin_us`.
     #[arg(long)]
     pub spin_us: Option<u32>,
+    /// Replaces one config value before it is checked, `section.key=value` (repeatable): e.g.
+    /// the stabilizer parts a kinematic simulator's rigid robot cannot use
+    /// (`client::process::kinematic_sim_settings`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub overrides: Vec<String>,
 }
 
 /// A failure with the exit code it maps to.
@@ -124,7 +129,11 @@ fn load(args: &DaemonArgs) -> Result<Setup, Failure> {
         ))
     })?;
     // The config file is read and parsed once; each part validates its own section.
-    let file = ConfigFile::load(config).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
+    let mut file = ConfigFile::load(config).map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
+    for assignment in &args.overrides {
+        file.set(assignment)
+            .map_err(|e| fail(exit_code::USAGE)(anyhow::Error::from(e).context("--set")))?;
+    }
     let mut runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())
         .map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
     if let Some(rate) = args.rate_hz {

@@ -2,10 +2,13 @@
 //!
 //! ```text
 //! walk-sim --config configs/armar4.toml --physics kinematic|mujoco [--clock realtime|lockstep]
-//!          [--rate-hz F] [--urdf PATH] [--service-prefix P]
+//!          [--rate-hz F] [--urdf PATH] [--service-prefix P] [--judge-by-zmp]
 //!          [--snapshots DIR [--snapshot-period S] [--snapshot-lookat X,Y,Z]]
 //!          [--inject KIND [--inject-step K] [--inject-delay S]]
 //! ```
+//! With `--judge-by-zmp` (kinematic only) the kinematic simulator judges stability, and
+//! synthesises the foot forces, by the ZMP of its motion instead of its CoM: for dynamic walks,
+//! as `walk-bench` does for the dynamic gait (`kinematic_sim::SimOptions::judge_by_zmp`).
 //! With `--inject` (evaluation of the controlled stop, `sim_adapter::inject`) it reports one bad
 //! sample, withholds a touchdown or asks walkd for a hold or abort, `--inject-delay` seconds of
 //! simulated time after the `--inject-step`-th lift-off of a foot.
@@ -22,7 +25,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use clap::Parser;
-use kinematic_sim::{KinematicSim, Simulator};
+use kinematic_sim::{KinematicSim, SimOptions, Simulator};
 use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::process::{
@@ -56,6 +59,11 @@ struct Args {
     /// Service prefix, overriding `[runtime] service_prefix`.
     #[arg(long)]
     service_prefix: Option<String>,
+    /// `--physics kinematic`: judge stability, and synthesise the foot forces, by the ZMP of the
+    /// simulated motion instead of its CoM, for dynamic walks (a dynamic walk's CoM leaves the
+    /// support polygon by design).
+    #[arg(long)]
+    judge_by_zmp: bool,
     /// `--physics mujoco`: save a picture of the robot (MuJoCo's offscreen renderer, EGL) every
     /// `--snapshot-period` of simulated time into this directory (needs --features
     /// sim-adapter/render).
@@ -141,10 +149,21 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
     match args.physics {
         Physics::Kinematic => {
             let standing = robot.standing.clone();
-            let sim = KinematicSim::new(robot, standing)
+            let options = SimOptions {
+                judge_by_zmp: args.judge_by_zmp,
+                ..SimOptions::default()
+            };
+            let sim = KinematicSim::with_options(robot, standing, options)
                 .map_err(|e| config_error(anyhow::Error::from(e).context("standing posture")))?;
             serve(&runtime, args, SimulatedRobot::new(sim))
         }
+        Physics::Mujoco if args.judge_by_zmp => Err((
+            exit_code::USAGE,
+            anyhow::anyhow!(
+                "--judge-by-zmp applies to --physics kinematic only (MuJoCo's contacts carry \
+                 the forces its physics makes)"
+            ),
+        )),
         Physics::Mujoco => serve_mujoco(robot, &runtime, args),
     }
 }
