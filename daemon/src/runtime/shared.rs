@@ -22,7 +22,8 @@ pub struct Submission {
 pub enum StartOutcome {
     /// Executing it.
     Started,
-    /// The controller refused to start it (busy, in fault, no valid measurement, not upright).
+    /// The controller refused to start it (busy, in fault, no valid measurement, not upright,
+    /// not on both feet for a dynamic walk).
     Refused(StartRefusal),
     /// No fresh samples from the adapter: nothing could execute it.
     AdapterStale,
@@ -31,36 +32,34 @@ pub enum StartOutcome {
 }
 
 impl StartOutcome {
-    const REFUSALS: [StartRefusal; 4] = [
-        StartRefusal::Busy,
-        StartRefusal::Faulted,
-        StartRefusal::NoMeasurement,
-        StartRefusal::NotUpright,
-    ];
-
+    /// The outcome's code in the result word: every outcome has its own, so a refusal added to
+    /// [`StartRefusal`] does not compile until it has one here and in [`StartOutcome::from_code`].
     fn code(self) -> u8 {
         match self {
             Self::Started => 1,
             Self::AdapterStale => 2,
             Self::SecondAdapter => 3,
-            Self::Refused(refusal) => {
-                10 + Self::REFUSALS
-                    .iter()
-                    .position(|r| *r == refusal)
-                    .unwrap_or(0) as u8
-            }
+            Self::Refused(StartRefusal::Busy) => 10,
+            Self::Refused(StartRefusal::Faulted) => 11,
+            Self::Refused(StartRefusal::NoMeasurement) => 12,
+            Self::Refused(StartRefusal::NotUpright) => 13,
+            Self::Refused(StartRefusal::NotOnBothFeet) => 14,
         }
     }
 
+    /// The outcome of a code written by [`StartOutcome::code`].
     fn from_code(code: u8) -> Option<Self> {
-        match code {
-            1 => Some(Self::Started),
-            2 => Some(Self::AdapterStale),
-            3 => Some(Self::SecondAdapter),
-            _ => Self::REFUSALS
-                .get(usize::from(code.checked_sub(10)?))
-                .map(|r| Self::Refused(*r)),
-        }
+        Some(match code {
+            1 => Self::Started,
+            2 => Self::AdapterStale,
+            3 => Self::SecondAdapter,
+            10 => Self::Refused(StartRefusal::Busy),
+            11 => Self::Refused(StartRefusal::Faulted),
+            12 => Self::Refused(StartRefusal::NoMeasurement),
+            13 => Self::Refused(StartRefusal::NotUpright),
+            14 => Self::Refused(StartRefusal::NotOnBothFeet),
+            _ => return None,
+        })
     }
 }
 
@@ -176,5 +175,38 @@ impl Shared {
 impl Default for Shared {
     fn default() -> Self {
         Self::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_start_outcome_round_trips_through_its_code() {
+        let refusals = [
+            StartRefusal::Busy,
+            StartRefusal::Faulted,
+            StartRefusal::NoMeasurement,
+            StartRefusal::NotUpright,
+            StartRefusal::NotOnBothFeet,
+        ];
+        let outcomes = [
+            StartOutcome::Started,
+            StartOutcome::AdapterStale,
+            StartOutcome::SecondAdapter,
+        ]
+        .into_iter()
+        .chain(refusals.map(StartOutcome::Refused));
+        let shared = Shared::new();
+        for (ticket, outcome) in (1..).zip(outcomes) {
+            shared.report_start(ticket, outcome);
+            assert_eq!(shared.start_outcome(ticket), Some(outcome));
+        }
+        for code in 0..=u8::MAX {
+            if let Some(outcome) = StartOutcome::from_code(code) {
+                assert_eq!(outcome.code(), code);
+            }
+        }
     }
 }
