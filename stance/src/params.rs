@@ -20,8 +20,9 @@ pub enum ContactUnification {
 
 /// How a sequence is walked: each gait post-processes with its own limits (a dynamic walk
 /// takes longer steps than a statically stable one), so the choice is made before
-/// post-processing and travels with the sequence to the controller.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+/// post-processing and travels with the sequence to the controller. Read from its name only
+/// (anything else is refused as not `"static"` or `"dynamic"`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Gait {
     /// Quasi-static: the CoM stays over the support polygon; contact changes wait for targets
@@ -70,6 +71,25 @@ impl Gait {
             .ok_or_else(|| fail(format!("`default` must be a string, not {value}")))?
             .parse()
             .map_err(|e: String| fail(format!("`default`: {e}")))
+    }
+}
+
+impl<'de> Deserialize<'de> for Gait {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        /// Takes a name; says what is expected instead of anything else (serde's derived enum
+        /// reader answers a number with "expected value", as if the JSON were broken).
+        struct Name;
+        impl serde::de::Visitor<'_> for Name {
+            type Value = Gait;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("\"static\" or \"dynamic\"")
+            }
+            fn visit_str<E: serde::de::Error>(self, name: &str) -> Result<Gait, E> {
+                name.parse()
+                    .map_err(|_| E::invalid_value(serde::de::Unexpected::Str(name), &self))
+            }
+        }
+        deserializer.deserialize_any(Name)
     }
 }
 
