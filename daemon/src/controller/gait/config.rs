@@ -237,6 +237,15 @@ impl GaitConfig {
             parsed.validate(origin)?;
             config.dynamic = Some(parsed);
         }
+        if config.default == Gait::Dynamic && config.dynamic.is_none() {
+            return Err(ConfigError::Section {
+                origin: origin.to_owned(),
+                section: GAIT,
+                message: "default = \"dynamic\" needs a [gait.dynamic] section (the dynamic \
+                          gait's tuning); add one, or keep default = \"static\""
+                    .to_owned(),
+            });
+        }
         Ok(config)
     }
 }
@@ -377,6 +386,17 @@ mod tests {
         assert_eq!(config.default, Gait::Static);
         let reason = config.dynamic().unwrap_err();
         assert!(reason.contains("[gait.dynamic]"), "{reason}");
+    }
+
+    #[test]
+    fn a_dynamic_default_without_its_section_is_refused_naming_the_file_and_the_section() {
+        let error = parse("[gait]\ndefault = \"dynamic\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("robot.toml") && error.contains("[gait.dynamic]"),
+            "{error}"
+        );
     }
 
     #[test]
