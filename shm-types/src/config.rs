@@ -44,6 +44,9 @@ pub struct RuntimeConfig {
     pub max_stances: usize,
 }
 
+/// The longest a watchdog may wait before holding, `watchdog_periods / rate_hz` (s).
+pub const WATCHDOG_MAX_S: f64 = 2.0;
+
 fn default_rate_hz() -> f64 {
     500.0
 }
@@ -81,9 +84,70 @@ pub enum ConfigError {
         /// What is wrong, naming the key.
         message: String,
     },
+    /// A command-line value that replaces a `[runtime]` key is out of range (or makes another
+    /// key so).
+    #[error("{flags}: [runtime]: {message}")]
+    Override {
+        /// The overriding flags and their values (`--rate-hz 1000000000000`).
+        flags: String,
+        /// What is wrong, naming the key.
+        message: String,
+    },
+}
+
+/// Command-line values that replace `[runtime]` keys: the flags of walkd and walk-sim named
+/// after them (`--rate-hz`, `--service-prefix`, `--fifo-priority`, `--cpu`, `--spin-us`). They
+/// are checked like the file's values, the error naming the flags.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RuntimeOverrides {
+    /// `--rate-hz`.
+    pub rate_hz: Option<f64>,
+    /// `--service-prefix`.
+    pub service_prefix: Option<String>,
+    /// `--fifo-priority`.
+    pub fifo_priority: Option<i32>,
+    /// `--cpu`.
+    pub cpu: Option<usize>,
+    /// `--spin-us`.
+    pub spin_us: Option<u32>,
+}
+
+impl RuntimeOverrides {
+    /// `runtime` with the given values in place, checked.
+    pub fn apply(&self, mut runtime: RuntimeConfig) -> Result<RuntimeConfig, ConfigError> {
+        let mut flags = Vec::new();
+        if let Some(rate) = self.rate_hz {
+            runtime.rate_hz = rate;
+            flags.push(format!("--rate-hz {rate}"));
+        }
+        if let Some(prefix) = &self.service_prefix {
+            runtime.service_prefix.clone_from(prefix);
+            flags.push(format!("--service-prefix {prefix}"));
+        }
+        if let Some(priority) = self.fifo_priority {
+            runtime.fifo_priority = Some(priority);
+            flags.push(format!("--fifo-priority {priority}"));
+        }
+        if let Some(cpu) = self.cpu {
+            runtime.cpu = Some(cpu);
+            flags.push(format!("--cpu {cpu}"));
+        }
+        if let Some(spin_us) = self.spin_us {
+            runtime.spin_us = spin_us;
+            flags.push(format!("--spin-us {spin_us}"));
+        }
+        runtime.check().map_err(|message| ConfigError::Override {
+            flags: flags.join(" "),
+            message,
+        })?;
+        Ok(runtime)
+    }
 }
 
 impl RuntimeConfig {
+    /// The range of `rate_hz` (Hz), also of every `--rate-hz`.
+    pub const RATE_HZ: std::ops::RangeInclusive<f64> = 10.0..=10_000.0;
+
     /// Reads the `[runtime]` section (`None`: the file has none); `origin` names the file.
     pub fn from_section(section: Option<&toml::Value>, origin: &str) -> Result<Self, ConfigError> {
         let section = section.ok_or_else(|| ConfigError::MissingSection {
@@ -96,39 +160,73 @@ impl RuntimeConfig {
         let config: Self = section
             .clone()
             .try_into()
-            .map_err(|e: toml::de::Error| invalid(e.message().to_owned()))?;
-        config.validate().map_err(invalid)?;
+            // The error's text names the key of a badly typed value; its message alone does not.
+            .map_err(|e: toml::de::Error| invalid(e.to_string().trim_end().replace('\n', " ")))?;
+        config.check().map_err(invalid)?;
         Ok(config)
     }
 
-    fn validate(&self) -> Result<(), String> {
-        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0 && self.rate_hz <= 10_000.0) {
-            return Err(format!("rate_hz = {} must be in (0, 10000]", self.rate_hz));
+    /// Checks every value against its documented range (docs/ipc.md, "[runtime]") and the
+    /// watchdogs against [`WATCHDOG_MAX_S`]; the error names the key. Run at load
+    /// and again after command-line overrides ([`RuntimeOverrides::apply`]).
+    pub fn check(&self) -> Result<(), String> {
+        let numbers = [
+            ("rate_hz", self.rate_hz, Self::RATE_HZ),
+            ("status_rate_hz", self.status_rate_hz, 1.0..=1000.0),
+        ];
+        let counts = [
+            (
+                "watchdog_periods",
+                i128::from(self.watchdog_periods),
+                1..=1000,
+            ),
+            (
+                "lockstep_timeout_ms",
+                i128::from(self.lockstep_timeout_ms),
+                1..=5000,
+            ),
+            (
+                "fifo_priority",
+                self.fifo_priority.map_or(1, i128::from),
+                1..=99,
+            ),
+            // A CPU the affinity mask can name (CPU_SETSIZE).
+            ("cpu", self.cpu.map_or(0, |c| c as i128), 0..=1023),
+            ("spin_us", i128::from(self.spin_us), 0..=10_000),
+            (
+                "max_submission_bytes",
+                self.max_submission_bytes as i128,
+                1024..=1 << 30,
+            ),
+            ("max_stances", self.max_stances as i128, 1..=1_000_000),
+        ];
+        for (key, value, range) in numbers {
+            if !range.contains(&value) {
+                return Err(format!("{key} = {value:?}: {}", requirement(&range)));
+            }
         }
-        if !(self.status_rate_hz.is_finite() && self.status_rate_hz > 0.0) {
+        for (key, value, range) in counts {
+            if !range.contains(&value) {
+                return Err(format!("{key} = {value}: {}", requirement(&range)));
+            }
+        }
+        let watchdog_s = f64::from(self.watchdog_periods) / self.rate_hz;
+        if watchdog_s > WATCHDOG_MAX_S {
             return Err(format!(
-                "status_rate_hz = {} must be positive",
-                self.status_rate_hz
+                "watchdog_periods = {} at rate_hz = {} holds only after {watchdog_s} s without a \
+                 sample: must be at most {} s",
+                self.watchdog_periods, self.rate_hz, WATCHDOG_MAX_S
             ));
-        }
-        if self.watchdog_periods == 0 {
-            return Err("watchdog_periods must be at least 1".to_owned());
-        }
-        if self.lockstep_timeout_ms == 0 {
-            return Err("lockstep_timeout_ms must be at least 1".to_owned());
-        }
-        if let Some(priority) = self.fifo_priority
-            && !(1..=99).contains(&priority)
-        {
-            return Err(format!("fifo_priority = {priority} must be in 1..=99"));
-        }
-        if self.max_submission_bytes == 0 || self.max_stances == 0 {
-            return Err("max_submission_bytes and max_stances must be at least 1".to_owned());
         }
         crate::ServiceNames::new(&self.service_prefix)
             .map_err(|e| format!("service_prefix: {e}"))?;
         Ok(())
     }
+}
+
+/// `must be in [min, max]` for a documented range.
+fn requirement<T: std::fmt::Display>(range: &std::ops::RangeInclusive<T>) -> String {
+    format!("must be in [{}, {}]", range.start(), range.end())
 }
 
 #[cfg(test)]
@@ -163,5 +261,59 @@ mod tests {
             parse("[robot]\n"),
             Err(ConfigError::MissingSection { .. })
         ));
+    }
+
+    #[test]
+    fn values_outside_their_ranges_are_refused_naming_the_key() {
+        for (key, value) in [
+            ("status_rate_hz", "1e-300"),
+            ("status_rate_hz", "1e300"),
+            ("rate_hz", "1e-3"),
+            ("watchdog_periods", "4294967295"),
+            ("lockstep_timeout_ms", "18446744073709"),
+            ("spin_us", "4294967295"),
+            ("max_stances", "9223372036854775807"),
+            ("max_submission_bytes", "9223372036854775807"),
+            ("cpu", "100000"),
+            ("watchdog_periods", "-1"),
+            ("lockstep_timeout_ms", "1.5"),
+            ("fifo_priority", "1e10"),
+            ("rate_hz", "nan"),
+        ] {
+            let text = format!("[runtime]\nservice_prefix = \"walk/r\"\n{key} = {value}\n");
+            let error = parse(&text).expect_err(&text).to_string();
+            assert!(
+                error.contains("robot.toml") && error.contains(key),
+                "{key} = {value}: {error}"
+            );
+        }
+    }
+
+    #[test]
+    fn overrides_are_checked_like_the_file_and_name_their_flags() {
+        let runtime =
+            parse("[runtime]\nservice_prefix = \"walk/r\"\nwatchdog_periods = 100\n").unwrap();
+        let overrides = |rate_hz| RuntimeOverrides {
+            rate_hz: Some(rate_hz),
+            ..RuntimeOverrides::default()
+        };
+        assert_eq!(
+            overrides(1000.0).apply(runtime.clone()).unwrap().rate_hz,
+            1000.0
+        );
+        for (rate, named) in [
+            (1e12, "rate_hz"),
+            (f64::NAN, "rate_hz"),
+            (20.0, "watchdog_periods"),
+        ] {
+            let error = overrides(rate)
+                .apply(runtime.clone())
+                .unwrap_err()
+                .to_string();
+            assert!(
+                error.starts_with(&format!("--rate-hz {rate}: [runtime]: {named} =")),
+                "{error}"
+            );
+        }
     }
 }

@@ -3,10 +3,50 @@
 //! naming the file and key (or the flag) and the documented exit code, never in a panic, an
 //! abort or a process that cannot be stopped.
 
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use client::process::Process;
 use walk_tests::{bin_dir, config, start_connected, unique_prefix};
+
+/// A copy of `configs/<robot>.toml` (its URDF path made absolute) with each `key = ...` line
+/// of `replacements` replaced by `key = value`; the copy is removed when the guard drops.
+struct ConfigCopy(PathBuf);
+
+impl ConfigCopy {
+    fn new(robot: &str, test: &str, replacements: &[(&str, &str)]) -> Self {
+        let original = config(robot);
+        let configs = original.parent().unwrap().canonicalize().unwrap();
+        let mut text = std::fs::read_to_string(&original).unwrap().replace(
+            "urdf = \"robots/",
+            &format!("urdf = \"{}/robots/", configs.display()),
+        );
+        for (key, value) in replacements {
+            let line = text
+                .lines()
+                .find(|line| line.starts_with(&format!("{key} =")))
+                .unwrap_or_else(|| panic!("{key} is not in {}", original.display()))
+                .to_owned();
+            text = text.replace(&line, &format!("{key} = {value}"));
+        }
+        let path = std::env::temp_dir().join(format!(
+            "walk-e2e-{}-{test}-{robot}.toml",
+            std::process::id()
+        ));
+        std::fs::write(&path, text).unwrap();
+        Self(path)
+    }
+
+    fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for ConfigCopy {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
 
 /// Starts `binary` of the workspace with `args` and waits up to `timeout` for it to exit on its
 /// own; a process still running then is stopped with SIGTERM (and the test fails).
@@ -57,4 +97,54 @@ fn record_onto_a_full_disk_stops_and_names_the_file_and_the_os_error() {
         elapsed < Duration::from_secs(10),
         "the recording ran on for {elapsed:?} after its file failed\n{log}"
     );
+}
+
+/// A status rate of 1e-300 Hz (a status every 1e300 s) is refused at load, naming the file and
+/// the key: exit 3 (config), not a panic (exit 101).
+#[test]
+fn walkd_refuses_a_vanishing_status_rate_naming_the_file_and_key() {
+    let copy = ConfigCopy::new("jvrc1", "status-rate", &[("status_rate_hz", "1e-300")]);
+    let prefix = unique_prefix("status-rate");
+    let args = [
+        "--config",
+        copy.path().to_str().unwrap(),
+        "--service-prefix",
+        &prefix,
+        "--no-lock-memory",
+    ];
+    let (code, log) = run_to_exit("walkd", &args, Duration::from_secs(10));
+    assert_eq!(code, Some(3), "{log}");
+    assert!(
+        log.contains(&copy.path().display().to_string())
+            && log.contains("[runtime]")
+            && log.contains("status_rate_hz"),
+        "{log}"
+    );
+}
+
+/// walk-sim's `--rate-hz` is checked like `[runtime] rate_hz`: 1e12 Hz (a period of 0 ns) and
+/// 1e-3 Hz (a period of 1000 s, slept through SIGTERM) are refused at once, naming the flag:
+/// exit 2 (usage), no panic.
+#[test]
+fn walk_sim_refuses_rates_outside_the_range_naming_the_flag() {
+    let config = config("jvrc1");
+    for rate in ["1e12", "1e-3", "NaN", "-500"] {
+        let prefix = unique_prefix("sim-rate");
+        let flag = format!("--rate-hz={rate}");
+        let args = [
+            "--config",
+            config.to_str().unwrap(),
+            "--physics",
+            "kinematic",
+            "--service-prefix",
+            &prefix,
+            &flag,
+        ];
+        let (code, log) = run_to_exit("walk-sim", &args, Duration::from_secs(10));
+        assert_eq!(code, Some(2), "--rate-hz {rate}: {log}");
+        assert!(
+            log.contains("--rate-hz") && !log.contains("panicked"),
+            "--rate-hz {rate}: {log}"
+        );
+    }
 }

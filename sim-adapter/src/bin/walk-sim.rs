@@ -23,7 +23,8 @@ use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::process::{Physics, exit_code, install_termination_handler, termination_requested};
 use shm_types::{
-    AdapterPorts, ClockMode, RuntimeConfig, ServiceNames, TruthPublisher, current_thread_is_fifo,
+    AdapterPorts, ClockMode, RuntimeConfig, RuntimeOverrides, ServiceNames, TruthPublisher,
+    current_thread_is_fifo,
 };
 use sim_adapter::{AdapterOptions, PublishTruth, SimulatedRobot, run_adapter};
 
@@ -84,20 +85,16 @@ fn main() -> ExitCode {
 fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
     let config_error = |e: anyhow::Error| (exit_code::CONFIG, e);
     let file = ConfigFile::load(&args.config).map_err(|e| config_error(e.into()))?;
-    let mut runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())
+    let runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())
         .map_err(|e| config_error(e.into()))?;
-    if let Some(rate) = args.rate_hz {
-        runtime.rate_hz = rate;
-    }
-    if let Some(prefix) = &args.service_prefix {
-        runtime.service_prefix.clone_from(prefix);
-    }
-    if !(runtime.rate_hz.is_finite() && runtime.rate_hz > 0.0) {
-        return Err(config_error(anyhow::anyhow!(
-            "--rate-hz {} must be positive",
-            runtime.rate_hz
-        )));
-    }
+    let overrides = RuntimeOverrides {
+        rate_hz: args.rate_hz,
+        service_prefix: args.service_prefix.clone(),
+        ..RuntimeOverrides::default()
+    };
+    let runtime = overrides
+        .apply(runtime)
+        .map_err(|e| (exit_code::USAGE, e.into()))?;
     let robot =
         Robot::from_config(&file, args.urdf.as_deref()).map_err(|e| config_error(e.into()))?;
     let robot = Arc::new(robot);
