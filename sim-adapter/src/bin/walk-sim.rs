@@ -20,6 +20,7 @@ use std::time::Duration;
 use clap::Parser;
 use kinematic_sim::{KinematicSim, Simulator};
 use kinematics::ConfigFile;
+use kinematics::bounds::Range;
 use kinematics::robot::Robot;
 use shm_types::process::{Physics, exit_code, install_termination_handler, termination_requested};
 use shm_types::{
@@ -55,11 +56,17 @@ struct Args {
     /// sim-adapter/render).
     #[arg(long, value_name = "DIR")]
     snapshots: Option<PathBuf>,
-    /// Simulated time between two pictures (s).
-    #[arg(long, default_value_t = 0.5)]
+    /// Simulated time between two pictures (s, 0.01-60).
+    #[arg(long, default_value_t = 0.5, value_parser = Range::new(0.01, 60.0).parser())]
     snapshot_period: f64,
-    /// The point the side camera looks at: x,y,z (m, world).
-    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.0, 0.8])]
+    /// The point the side camera looks at: x,y,z (m, world; each within ±100).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_values_t = [0.0, 0.0, 0.8],
+        allow_hyphen_values = true,
+        value_parser = Range::new(-100.0, 100.0).parser()
+    )]
     snapshot_lookat: Vec<f64>,
 }
 
