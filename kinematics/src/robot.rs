@@ -88,6 +88,16 @@ pub struct SoleRectangle {
     pub width: f64,
 }
 
+impl SoleRectangle {
+    /// The `[robot] sole` table: each extent, its value and its range (docs/kinematics.md).
+    pub fn bounds(&self) -> [Bound; 2] {
+        [
+            Bound::new("sole.length", self.length, 0.01, 1.0),
+            Bound::new("sole.width", self.width, 0.01, 1.0),
+        ]
+    }
+}
+
 /// Joint indices (model order) of each body part, for posture tasks and stance retargeting.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct JointGroups {
@@ -405,13 +415,8 @@ impl Loader<'_> {
         names.iter().map(|name| self.joint(key, name)).collect()
     }
 
-    /// The sole's size: the ranges of `[robot]`'s numbers (docs/kinematics.md).
     fn check_sole(&self, sole: &SoleRectangle) -> Result<(), RobotError> {
-        let bounds = [
-            Bound::new("sole.length", sole.length, 0.01, 1.0),
-            Bound::new("sole.width", sole.width, 0.01, 1.0),
-        ];
-        match first_outside(&bounds) {
+        match first_outside(&sole.bounds()) {
             Some(violation) => Err(self.invalid(
                 violation.key,
                 format!(

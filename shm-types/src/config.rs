@@ -170,63 +170,90 @@ impl RuntimeConfig {
     /// watchdogs against [`WATCHDOG_MAX_S`]; the error names the key. Run at load
     /// and again after command-line overrides ([`RuntimeOverrides::apply`]).
     pub fn check(&self) -> Result<(), String> {
-        let numbers = [
-            ("rate_hz", self.rate_hz, Self::RATE_HZ),
-            ("status_rate_hz", self.status_rate_hz, 1.0..=1000.0),
-        ];
-        let counts = [
-            (
-                "watchdog_periods",
-                i128::from(self.watchdog_periods),
-                1..=1000,
-            ),
-            (
-                "lockstep_timeout_ms",
-                i128::from(self.lockstep_timeout_ms),
-                1..=5000,
-            ),
-            (
-                "fifo_priority",
-                self.fifo_priority.map_or(1, i128::from),
-                1..=99,
-            ),
-            // A CPU the affinity mask can name (CPU_SETSIZE).
-            ("cpu", self.cpu.map_or(0, |c| c as i128), 0..=1023),
-            ("spin_us", i128::from(self.spin_us), 0..=10_000),
-            (
-                "max_submission_bytes",
-                self.max_submission_bytes as i128,
-                1024..=1 << 30,
-            ),
-            ("max_stances", self.max_stances as i128, 1..=1_000_000),
-        ];
-        for (key, value, range) in numbers {
-            if !range.contains(&value) {
-                return Err(format!("{key} = {value:?}: {}", requirement(&range)));
-            }
-        }
-        for (key, value, range) in counts {
-            if !range.contains(&value) {
-                return Err(format!("{key} = {value}: {}", requirement(&range)));
+        for bound in self.bounds() {
+            if let Some(value) = bound.value
+                && !(bound.min <= value && value <= bound.max)
+            {
+                // Integers as written; others (NaN, 1e-300) as Rust reads them.
+                let shown = if value.fract() == 0.0 && value.abs() < 1e16 {
+                    format!("{value:.0}")
+                } else {
+                    format!("{value:?}")
+                };
+                return Err(format!(
+                    "{} = {shown}: must be in [{}, {}]",
+                    bound.key, bound.min, bound.max
+                ));
             }
         }
         let watchdog_s = f64::from(self.watchdog_periods) / self.rate_hz;
         if watchdog_s > WATCHDOG_MAX_S {
             return Err(format!(
                 "watchdog_periods = {} at rate_hz = {} holds only after {watchdog_s} s without a \
-                 sample: must be at most {} s",
-                self.watchdog_periods, self.rate_hz, WATCHDOG_MAX_S
+                 sample: must be at most {WATCHDOG_MAX_S} s",
+                self.watchdog_periods, self.rate_hz,
             ));
         }
         crate::ServiceNames::new(&self.service_prefix)
             .map_err(|e| format!("service_prefix: {e}"))?;
         Ok(())
     }
+
+    /// The section's table: every numeric key, its value and its range, one line a key.
+    pub fn bounds(&self) -> Vec<RuntimeBound> {
+        let bound = |key, value: Option<f64>, min, max| RuntimeBound {
+            key,
+            value,
+            min,
+            max,
+        };
+        let (rate_min, rate_max) = (*Self::RATE_HZ.start(), *Self::RATE_HZ.end());
+        vec![
+            bound("rate_hz", Some(self.rate_hz), rate_min, rate_max),
+            bound("status_rate_hz", Some(self.status_rate_hz), 1.0, 1000.0),
+            bound(
+                "watchdog_periods",
+                Some(self.watchdog_periods.into()),
+                1.0,
+                1000.0,
+            ),
+            bound(
+                "lockstep_timeout_ms",
+                Some(self.lockstep_timeout_ms as f64),
+                1.0,
+                5000.0,
+            ),
+            bound(
+                "fifo_priority",
+                self.fifo_priority.map(f64::from),
+                1.0,
+                99.0,
+            ),
+            // A CPU the affinity mask can name (CPU_SETSIZE).
+            bound("cpu", self.cpu.map(|cpu| cpu as f64), 0.0, 1023.0),
+            bound("spin_us", Some(self.spin_us.into()), 0.0, 10_000.0),
+            bound(
+                "max_submission_bytes",
+                Some(self.max_submission_bytes as f64),
+                1024.0,
+                (1u64 << 30) as f64,
+            ),
+            bound("max_stances", Some(self.max_stances as f64), 1.0, 1e6),
+        ]
+    }
 }
 
-/// `must be in [min, max]` for a documented range.
-fn requirement<T: std::fmt::Display>(range: &std::ops::RangeInclusive<T>) -> String {
-    format!("must be in [{}, {}]", range.start(), range.end())
+/// One numeric key of `[runtime]`: its value (`None`: an optional key left out) and its range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RuntimeBound {
+    /// The key.
+    pub key: &'static str,
+    /// Its value.
+    pub value: Option<f64>,
+    /// The smallest value allowed.
+    pub min: f64,
+    /// The largest value allowed.
+    pub max: f64,
 }
 
 #[cfg(test)]

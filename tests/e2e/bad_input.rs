@@ -148,3 +148,90 @@ fn walk_sim_refuses_rates_outside_the_range_naming_the_flag() {
         );
     }
 }
+
+/// walk-sim's numbers, fuzzed on the binary itself (its arguments live in it): every value
+/// either starts it, and then SIGTERM ends it within a second, or is refused at once naming the
+/// flag (exit 2). Never a panic, never a process that runs on.
+#[test]
+fn walk_sim_takes_every_number_in_range_or_refuses_it_by_flag() {
+    let config = config("jvrc1");
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut random = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let (mut tried, mut started) = (0, 0);
+    for flag in ["--rate-hz", "--snapshot-period", "--snapshot-lookat"] {
+        let mut values: Vec<String> = [
+            "0",
+            "-1",
+            "1e-300",
+            "1e300",
+            "NaN",
+            "inf",
+            "-inf",
+            "4294967296",
+            "1e400",
+            "fast",
+            "10",
+            "500",
+            "0.5",
+            "10000",
+        ]
+        .map(str::to_owned)
+        .to_vec();
+        values.extend((0..6).map(|_| {
+            let exponent = (random() % 16) as i32 - 8;
+            format!("{:?}", (1 + random() % 9) as f64 * 10f64.powi(exponent))
+        }));
+        for value in values {
+            tried += 1;
+            let prefix = unique_prefix("sim-fuzz");
+            let value = if flag == "--snapshot-lookat" {
+                format!("0,{value},0.8")
+            } else {
+                value
+            };
+            let arg = format!("{flag}={value}");
+            let args = [
+                "--config",
+                config.to_str().unwrap(),
+                "--physics",
+                "kinematic",
+                "--service-prefix",
+                &prefix,
+                &arg,
+            ];
+            let process = Process::start(&bin_dir().join("walk-sim"), args, &[]).unwrap();
+            let start = Instant::now();
+            while process.is_running()
+                && !process.log_text().contains("walk-sim running")
+                && start.elapsed() < Duration::from_secs(5)
+            {
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            if process.is_running() {
+                started += 1;
+                process.signal(libc::SIGTERM);
+                let exit = process.wait_exit(Duration::from_secs(1));
+                assert_eq!(
+                    exit.and_then(|s| s.code()),
+                    Some(0),
+                    "{arg}: {}",
+                    process.log()
+                );
+            } else {
+                let exit = process.wait_exit(Duration::from_secs(5));
+                let log = process.log();
+                assert_eq!(exit.and_then(|s| s.code()), Some(2), "{arg}: {log}");
+                assert!(
+                    log.contains(flag) && !log.contains("panicked"),
+                    "{arg}: {log}"
+                );
+            }
+        }
+    }
+    eprintln!("walk-sim: {tried} values tried, {started} started and stopped at SIGTERM, 0 panics");
+}
