@@ -4,6 +4,7 @@
 //! are written into a copy of a real robot config, which is then loaded through the loaders
 //! walkd, walk-sim, walk-bench and walkctl use. None may panic; each value is either accepted,
 //! and then inside its documented range, or refused by an error naming the file and the key.
+//! The docs page that owns each section lists the same ranges as the tables (checked here too).
 
 use std::collections::BTreeMap;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -241,5 +242,52 @@ fn every_config_number_is_in_range_or_refused_by_name_and_nothing_panics() {
         panics.len(),
         panics.join("\n")
     );
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+/// The `[min, max]` of the row of `key` in the docs page `text` (`| `key` | [min, max] ...`).
+fn documented_range(text: &str, key: &str) -> Option<(f64, f64)> {
+    let row = text
+        .lines()
+        .find(|line| line.starts_with(&format!("| `{key}` |")))?;
+    let range = &row[row.find('[')? + 1..];
+    let (min, max) = range[..range.find(']')?].split_once(", ")?;
+    Some((min.trim().parse().ok()?, max.trim().parse().ok()?))
+}
+
+#[test]
+fn every_range_is_documented_in_the_page_that_owns_its_section() {
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs");
+    let page = |name: &str| std::fs::read_to_string(docs.join(name)).unwrap();
+    let config = ConfigFile::parse(&config_text("jvrc1"), Path::new("jvrc1.toml")).unwrap();
+    let mut ranges: Vec<(String, &str, f64, f64)> = keys(&config)
+        .into_iter()
+        .filter(|key| key.table != "robot")
+        .map(|key| {
+            let page = match key.table {
+                "runtime" => "ipc.md",
+                "postprocess" | "postprocess.dynamic" => "stance.md",
+                _ => "controller.md",
+            };
+            (page.to_owned(), key.name, key.min, key.max)
+        })
+        .collect();
+    #[cfg(feature = "mujoco")]
+    ranges.extend(
+        sim_adapter::mujoco::MujocoOptions::default()
+            .bounds()
+            .into_iter()
+            .map(|b| ("mujoco.md".to_owned(), b.key, b.range.min, b.range.max)),
+    );
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-4 * b.abs().max(1e-12);
+    let mut wrong = Vec::new();
+    for (name, key, min, max) in ranges {
+        match documented_range(&page(&name), key) {
+            Some((a, b)) if close(a, min) && close(b, max) => {}
+            documented => wrong.push(format!(
+                "docs/{name}: `{key}` documented as {documented:?}, checked as [{min}, {max}]"
+            )),
+        }
+    }
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }
