@@ -14,10 +14,12 @@ use client::args::{DISTANCE_M, DURATION_S, RATE_HZ};
 use daemon::runtime::DaemonArgs;
 use kinematics::ConfigFile;
 use kinematics::bounds::Range;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use shm_types::RuntimeConfig;
 use walk_bench::command::BenchArgs;
+
+mod fuzz_values;
 
 /// Random values tried per flag, besides the fixed hostile ones.
 const RANDOM_VALUES: usize = 24;
@@ -72,6 +74,26 @@ impl Flag {
     }
 }
 
+/// The `flags` of the walkctl subcommand whose arguments are `A`, checked by parsing alone: the
+/// command line `base` (the subcommand and what it requires) and `flag=value`.
+fn parsed<A: clap::Args + 'static>(
+    base: &[&str],
+    flags: &[(&'static str, Option<Range>)],
+) -> Vec<Flag> {
+    let base: Vec<String> = base.iter().map(|arg| (*arg).to_owned()).collect();
+    let command: &'static str = format!("walkctl {}", base[0]).leak();
+    flags
+        .iter()
+        .map(|&(flag, range)| {
+            let base = base.clone();
+            Flag::new(command, flag, range, move |arg| {
+                let line: Vec<&str> = base.iter().map(String::as_str).chain([arg]).collect();
+                parse::<A>(&line).map(drop)
+            })
+        })
+        .collect()
+}
+
 /// The flags of walkd and walkctl (the client's argument structs).
 fn daemon_and_client_flags() -> Vec<Flag> {
     let cfg = config();
@@ -88,15 +110,6 @@ fn daemon_and_client_flags() -> Vec<Flag> {
                 .map_err(|e| e.to_string())?;
             let applied = args.runtime_overrides().apply(runtime.clone());
             applied.map(drop).map_err(|e| e.to_string())
-        }));
-    }
-    for (flag, range) in [
-        ("--distance", Some(DISTANCE_M)),
-        ("--rate-hz", Some(RATE_HZ)),
-        ("--seed", None),
-    ] {
-        flags.push(Flag::new("walkctl demo", flag, range, |arg| {
-            parse::<client::demo::DemoArgs>(&["demo", arg]).map(drop)
         }));
     }
     let postprocess_flags = [
@@ -147,12 +160,6 @@ fn daemon_and_client_flags() -> Vec<Flag> {
                 .map_err(|e| format!("{e:#}"))
         }));
     }
-    for flag in ["--order", "--discount", "--max-clusters"] {
-        flags.push(Flag::new("walkctl learn", flag, None, |arg| {
-            parse::<client::learn::LearnArgs>(&["learn", "--demos", "d", "-o", "m.json", arg])
-                .map(drop)
-        }));
-    }
     for (flag, range) in [
         ("--distances", Some(DISTANCE_M)),
         ("--runs", None),
@@ -163,51 +170,43 @@ fn daemon_and_client_flags() -> Vec<Flag> {
             args.cells.requests().map(drop).map_err(|e| e.to_string())
         }));
     }
-    for flag in ["--samples", "--runs"] {
-        let cfg = cfg.clone();
-        flags.push(Flag::new(
-            "walkctl bench-coverage",
-            flag,
-            None,
-            move |arg| {
-                let line = ["bench-coverage", "--robot", &cfg, arg];
-                parse::<client::bench_coverage::BenchCoverageArgs>(&line).map(drop)
-            },
-        ));
-    }
-    for flag in ["--runs", "--seed"] {
-        let cfg = cfg.clone();
-        flags.push(Flag::new(
-            "walkctl bench-postprocess",
-            flag,
-            None,
-            move |arg| {
-                let line = ["bench-postprocess", "--robot", &cfg, arg];
-                parse::<client::bench_postprocess::BenchPostprocessArgs>(&line).map(drop)
-            },
-        ));
-    }
-    flags.push(Flag::new("walkctl watch", "--timeout-s", None, |arg| {
-        parse::<client::watch::WatchArgs>(&["watch", arg]).map(drop)
-    }));
-    {
-        let cfg = cfg.clone();
-        flags.push(Flag::new(
-            "walkctl record",
-            "--duration",
-            Some(DURATION_S),
-            move |arg| {
-                let line = ["record", "--config", &cfg, "-o", "walk.mcap", arg];
-                parse::<client::observe::RecordArgs>(&line).map(drop)
-            },
-        ));
-    }
-    for (flag, range) in [("--duration", Some(DURATION_S)), ("--port", None)] {
-        let cfg = cfg.clone();
-        flags.push(Flag::new("walkctl view", flag, range, move |arg| {
-            parse::<client::observe::ViewArgs>(&["view", "--config", &cfg, arg]).map(drop)
-        }));
-    }
+    let m = "m.json".to_owned();
+    flags.extend(parsed::<client::demo::DemoArgs>(
+        &["demo"],
+        &[
+            ("--distance", Some(DISTANCE_M)),
+            ("--rate-hz", Some(RATE_HZ)),
+            ("--seed", None),
+        ],
+    ));
+    flags.extend(parsed::<client::learn::LearnArgs>(
+        &["learn", "--demos", "d", "-o", &m],
+        &[
+            ("--order", None),
+            ("--discount", None),
+            ("--max-clusters", None),
+        ],
+    ));
+    flags.extend(parsed::<client::bench_coverage::BenchCoverageArgs>(
+        &["bench-coverage", "--robot", &cfg],
+        &[("--samples", None), ("--runs", None)],
+    ));
+    flags.extend(parsed::<client::bench_postprocess::BenchPostprocessArgs>(
+        &["bench-postprocess", "--robot", &cfg],
+        &[("--runs", None), ("--seed", None)],
+    ));
+    flags.extend(parsed::<client::watch::WatchArgs>(
+        &["watch"],
+        &[("--timeout-s", None)],
+    ));
+    flags.extend(parsed::<client::observe::RecordArgs>(
+        &["record", "--config", &cfg, "-o", "walk.mcap"],
+        &[("--duration", Some(DURATION_S))],
+    ));
+    flags.extend(parsed::<client::observe::ViewArgs>(
+        &["view", "--config", &cfg],
+        &[("--duration", Some(DURATION_S)), ("--port", None)],
+    ));
     flags
 }
 
@@ -259,41 +258,9 @@ fn bench_flags() -> Vec<Flag> {
 /// The values tried for `flag`: hostile ones and random ones over many magnitudes, shaped as
 /// the flag takes them (`FROM:TO` for `--railing`, `x,y,z` for `--pelvis-com-offset`).
 fn values(flag: &str, rng: &mut ChaCha8Rng) -> Vec<String> {
-    let mut numbers: Vec<String> = [
-        "0",
-        "-0",
-        "-1",
-        "1",
-        "0.5",
-        "1e-300",
-        "1e300",
-        "-1e300",
-        "NaN",
-        "nan",
-        "inf",
-        "-inf",
-        "4294967295",
-        "4294967296",
-        "-2147483649",
-        "9223372036854775807",
-        "18446744073709551615",
-        "18446744073709551616",
-        "340282366920938463463374607431768211456",
-        "1e400",
-        "",
-        "fast",
-    ]
-    .map(str::to_owned)
-    .to_vec();
-    for _ in 0..RANDOM_VALUES {
-        let magnitude = 10f64.powf(rng.random_range(-12.0..12.0));
-        let sign = if rng.random_bool(0.8) { 1.0 } else { -1.0 };
-        numbers.push(if rng.random_bool(0.4) {
-            format!("{}", (sign * magnitude).round() as i64)
-        } else {
-            format!("{:?}", sign * magnitude)
-        });
-    }
+    let mut numbers: Vec<String> = fuzz_values::HOSTILE.map(str::to_owned).to_vec();
+    numbers.push(String::new());
+    numbers.extend(fuzz_values::random(rng, RANDOM_VALUES));
     match flag {
         "--railing" => numbers
             .iter()
@@ -346,11 +313,5 @@ fn every_command_line_number_is_in_range_or_refused_by_flag_and_nothing_panics()
         flags.len(),
         panics.len()
     );
-    assert!(
-        panics.is_empty(),
-        "{} panics:\n{}",
-        panics.len(),
-        panics.join("\n")
-    );
-    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    fuzz_values::assert_clean(&panics, &wrong);
 }

@@ -66,6 +66,23 @@ fn run_to_exit(binary: &str, args: &[&str], timeout: Duration) -> (Option<i32>, 
     (status.unwrap().code(), process.log_text())
 }
 
+/// The command line of a kinematic walk-sim for JVRC-1 on a prefix of its own, with `arg`.
+fn walk_sim_args(arg: &str) -> Vec<String> {
+    let config = config("jvrc1");
+    let prefix = unique_prefix("walk-sim");
+    [
+        "--config",
+        config.to_str().unwrap(),
+        "--physics",
+        "kinematic",
+        "--service-prefix",
+    ]
+    .into_iter()
+    .chain([prefix.as_str(), arg])
+    .map(str::to_owned)
+    .collect()
+}
+
 /// `walkctl record` onto a full disk (`/dev/full` answers every write with ENOSPC) stops at the
 /// first failed write, well before its duration, and says which file and why: exit 1, no panic.
 #[test]
@@ -127,19 +144,9 @@ fn walkd_refuses_a_vanishing_status_rate_naming_the_file_and_key() {
 /// exit 2 (usage), no panic.
 #[test]
 fn walk_sim_refuses_rates_outside_the_range_naming_the_flag() {
-    let config = config("jvrc1");
     for rate in ["1e12", "1e-3", "NaN", "-500"] {
-        let prefix = unique_prefix("sim-rate");
-        let flag = format!("--rate-hz={rate}");
-        let args = [
-            "--config",
-            config.to_str().unwrap(),
-            "--physics",
-            "kinematic",
-            "--service-prefix",
-            &prefix,
-            &flag,
-        ];
+        let args = walk_sim_args(&format!("--rate-hz={rate}"));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let (code, log) = run_to_exit("walk-sim", &args, Duration::from_secs(10));
         assert_eq!(code, Some(2), "--rate-hz {rate}: {log}");
         assert!(
@@ -154,7 +161,6 @@ fn walk_sim_refuses_rates_outside_the_range_naming_the_flag() {
 /// flag (exit 2). Never a panic, never a process that runs on.
 #[test]
 fn walk_sim_takes_every_number_in_range_or_refuses_it_by_flag() {
-    let config = config("jvrc1");
     let mut state = 0x9e37_79b9_7f4a_7c15_u64;
     let mut random = move || {
         state ^= state << 13;
@@ -188,22 +194,13 @@ fn walk_sim_takes_every_number_in_range_or_refuses_it_by_flag() {
         }));
         for value in values {
             tried += 1;
-            let prefix = unique_prefix("sim-fuzz");
             let value = if flag == "--snapshot-lookat" {
                 format!("0,{value},0.8")
             } else {
                 value
             };
             let arg = format!("{flag}={value}");
-            let args = [
-                "--config",
-                config.to_str().unwrap(),
-                "--physics",
-                "kinematic",
-                "--service-prefix",
-                &prefix,
-                &arg,
-            ];
+            let args = walk_sim_args(&arg);
             let process = Process::start(&bin_dir().join("walk-sim"), args, &[]).unwrap();
             let start = Instant::now();
             while process.is_running()

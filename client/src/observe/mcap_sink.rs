@@ -300,25 +300,42 @@ fn summarize(input: &mut impl Output, path: &Path) -> anyhow::Result<RecordingSu
 #[cfg(test)]
 mod tests {
     use std::io::Cursor;
+    use std::sync::atomic::{AtomicU64, Ordering};
 
     use foxglove::Channel;
     use foxglove::messages::Log;
 
     use super::*;
 
-    /// A disk with room for `room` bytes: every write beyond them fails with ENOSPC.
-    struct SmallDisk {
+    /// A disk in memory with room for `room` bytes (every write beyond fails with ENOSPC) that
+    /// counts the bytes read from it.
+    struct TestDisk {
         bytes: Cursor<Vec<u8>>,
         room: u64,
+        read: Arc<AtomicU64>,
     }
 
-    impl Read for SmallDisk {
-        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-            self.bytes.read(buf)
+    impl TestDisk {
+        fn new(room: u64) -> (Self, Arc<AtomicU64>) {
+            let read = Arc::new(AtomicU64::new(0));
+            let disk = Self {
+                bytes: Cursor::new(Vec::new()),
+                room,
+                read: Arc::clone(&read),
+            };
+            (disk, read)
         }
     }
 
-    impl Write for SmallDisk {
+    impl Read for TestDisk {
+        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            let n = self.bytes.read(buf)?;
+            self.read.fetch_add(n as u64, Ordering::Relaxed);
+            Ok(n)
+        }
+    }
+
+    impl Write for TestDisk {
         fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
             if self.bytes.position() + buf.len() as u64 > self.room {
                 return Err(io::Error::from_raw_os_error(libc::ENOSPC));
@@ -331,38 +348,7 @@ mod tests {
         }
     }
 
-    impl Seek for SmallDisk {
-        fn seek(&mut self, to: SeekFrom) -> io::Result<u64> {
-            self.bytes.seek(to)
-        }
-    }
-
-    /// Counts the bytes read from a recording's output (the summary must not read them all).
-    struct Counted {
-        bytes: Cursor<Vec<u8>>,
-        read: Arc<std::sync::atomic::AtomicU64>,
-    }
-
-    impl Read for Counted {
-        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-            let n = self.bytes.read(buf)?;
-            self.read
-                .fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed);
-            Ok(n)
-        }
-    }
-
-    impl Write for Counted {
-        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-            self.bytes.write(buf)
-        }
-
-        fn flush(&mut self) -> io::Result<()> {
-            Ok(())
-        }
-    }
-
-    impl Seek for Counted {
+    impl Seek for TestDisk {
         fn seek(&mut self, to: SeekFrom) -> io::Result<u64> {
             self.bytes.seek(to)
         }
@@ -392,10 +378,7 @@ mod tests {
     #[test]
     fn a_full_disk_ends_the_recording_with_the_file_and_the_os_error() {
         let context = Context::new();
-        let disk = SmallDisk {
-            bytes: Cursor::new(Vec::new()),
-            room: 20_000,
-        };
+        let (disk, _) = TestDisk::new(20_000);
         let recording = Recording::start(Path::new("walk.mcap"), disk, &context).unwrap();
         log_messages(&context, 5_000);
         assert!(recording.failed());
@@ -426,19 +409,15 @@ mod tests {
     #[test]
     fn the_summary_is_read_from_the_summary_section_only() {
         let context = Context::new();
-        let read = Arc::new(std::sync::atomic::AtomicU64::new(0));
-        let output = Counted {
-            bytes: Cursor::new(Vec::new()),
-            read: Arc::clone(&read),
-        };
-        let recording = Recording::start(Path::new("walk.mcap"), output, &context).unwrap();
+        let (disk, read) = TestDisk::new(u64::MAX);
+        let recording = Recording::start(Path::new("walk.mcap"), disk, &context).unwrap();
         log_messages(&context, 20_000);
         let summary = recording.finish().unwrap();
         assert_eq!(summary.messages, 20_000);
         assert_eq!(summary.channels.len(), 1);
         assert_eq!(summary.channels[0].topic, "/log");
         assert_eq!(summary.channels[0].messages, 20_000);
-        let read = read.load(std::sync::atomic::Ordering::Relaxed);
+        let read = read.load(Ordering::Relaxed);
         assert!(
             summary.bytes > 500_000 && read < summary.bytes / 100,
             "read {read} of {} bytes for the summary",
