@@ -12,6 +12,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
+use client::args::{DISTANCE_M, RATE_HZ};
 use daemon::controller::{Controller, ControllerConfig, ControllerState, SolverKind};
 use daemon::qp::{ClarabelSolver, DenseActiveSetSolver, QpSolver, export_json};
 use hdrhistogram::Histogram;
@@ -64,8 +65,13 @@ pub struct BenchArgs {
     /// URDF overriding the config's (required for HRP-4).
     #[arg(long, value_name = "PATH")]
     pub urdf: Option<PathBuf>,
-    /// Distance to walk (m), requested from the generator as distance / scf.
-    #[arg(long, value_name = "D", required_unless_present = "sequence")]
+    /// Distance to walk (m, 0.01-1000), requested from the generator as distance / scf.
+    #[arg(
+        long,
+        value_name = "D",
+        required_unless_present = "sequence",
+        value_parser = DISTANCE_M.parser()
+    )]
     pub distance: Option<f64>,
     /// Execute this stance file instead of generating: a post-processed sequence (as written
     /// by `walkctl postprocess`), or a raw one (`walkctl generate`) with --postprocess.
@@ -86,8 +92,8 @@ pub struct BenchArgs {
     /// QP back-end.
     #[arg(long, value_enum, default_value = "dense")]
     pub solver: SolverArg,
-    /// Control rate (Hz); default: [runtime] rate_hz of the config, else 500.
-    #[arg(long, value_name = "F")]
+    /// Control rate (Hz, 10-10000); default: [runtime] rate_hz of the config, else 500.
+    #[arg(long, value_name = "F", value_parser = RATE_HZ.parser())]
     pub rate_hz: Option<f64>,
     /// Seed of the stance generator (synthetic, or learned without --beam).
     #[arg(long, default_value_t = 0)]
@@ -149,10 +155,6 @@ fn run(args: &BenchArgs) -> anyhow::Result<bool> {
         }
         (None, None) => DEFAULT_RATE_HZ,
     };
-    anyhow::ensure!(
-        rate_hz.is_finite() && rate_hz > 0.0,
-        "--rate-hz {rate_hz}: must be a positive number"
-    );
     let (sequence, origin) = bench_sequence(args, &robot, params)?;
     let solver_kind = SolverKind::from(args.solver);
     let options = WalkOptions {

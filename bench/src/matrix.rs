@@ -9,9 +9,12 @@ use std::process::ExitCode;
 use std::sync::Mutex;
 
 use anyhow::Context;
+use clap::builder::RangedU64ValueParser;
 
+use client::args::RATE_HZ;
 use client::evaluate::{GroupSummary, MatrixCells, WalkRecord, group_by_cell, speed_cell};
 use kinematics::ConfigFile;
+use kinematics::bounds::Range;
 use serde::Serialize;
 use stance::{Gait, WalkRequest};
 
@@ -38,17 +41,19 @@ pub struct MatrixArgs {
     /// Affordance sets, distances and runs (run i uses generator seed `first_seed + i`).
     #[command(flatten)]
     pub cells: MatrixCells,
-    /// Control rate (Hz).
-    #[arg(long, default_value_t = 500.0)]
+    /// Control rate (Hz, 10-10000).
+    #[arg(long, default_value_t = 500.0, value_parser = RATE_HZ.parser())]
     pub rate_hz: f64,
     /// Replaces one config value, `section.key=value` (repeatable), e.g.
     /// `gait.dynamic.single_support_s=0.5` or `gait.dynamic.stabilizer.foot_damping=false`.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub overrides: Vec<String>,
-    /// Model error in the simulator only: every body's mass and inertia scaled by this.
+    /// Model error in the simulator only: every body's mass and inertia scaled by this
+    /// (0.1-10, the MuJoCo option `mass_scale`).
     #[arg(long, default_value_t = 1.0)]
     pub mass_scale: f64,
-    /// Model error in the simulator only: the pelvis CoM moved by x,y,z (m, pelvis frame).
+    /// Model error in the simulator only: the pelvis CoM moved by x,y,z (m, pelvis frame; each
+    /// within ±0.5, the MuJoCo option `pelvis_com_offset`).
     #[arg(
         long,
         value_delimiter = ',',
@@ -56,18 +61,23 @@ pub struct MatrixArgs {
         allow_hyphen_values = true
     )]
     pub pelvis_com_offset: Option<Vec<f64>>,
-    /// A sideways push on the pelvis (N·s along world y, + = left), centred on the middle of
-    /// single support number `--push-step` (dynamic gait).
-    #[arg(long, value_name = "N·s", allow_hyphen_values = true)]
+    /// A sideways push on the pelvis (N·s along world y, + = left, within ±1000), centred on
+    /// the middle of single support number `--push-step` (dynamic gait).
+    #[arg(
+        long,
+        value_name = "N·s",
+        allow_hyphen_values = true,
+        value_parser = Range::new(-1000.0, 1000.0).parser()
+    )]
     pub push_impulse: Option<f64>,
-    /// Which single support the push falls in (0: the first).
-    #[arg(long, default_value_t = 4)]
+    /// Which single support the push falls in (0: the first), at most 1000.
+    #[arg(long, default_value_t = 4, value_parser = RangedU64ValueParser::<usize>::new().range(0..=1000))]
     pub push_step: usize,
-    /// How long the push acts (s).
-    #[arg(long, default_value_t = 0.1)]
+    /// How long the push acts (s, 0.001-5).
+    #[arg(long, default_value_t = 0.1, value_parser = Range::new(0.001, 5.0).parser())]
     pub push_duration: f64,
-    /// Walks run at once (each in its own thread).
-    #[arg(long, default_value_t = 1)]
+    /// Walks run at once (each in its own thread), 1-64.
+    #[arg(long, default_value_t = 1, value_parser = RangedU64ValueParser::<usize>::new().range(1..=64))]
     pub jobs: usize,
     /// Print one JSON object instead of the table.
     #[arg(long)]
@@ -211,7 +221,9 @@ fn run(args: &MatrixArgs) -> anyhow::Result<MatrixReport> {
     })
 }
 
-fn walk_options(args: &MatrixArgs, gait: Gait) -> anyhow::Result<PhysicsWalkOptions> {
+/// The options of every walk of the matrix: the gait's, with the command line's rate, model
+/// error and push; the model error is checked like every MuJoCo option, naming its flag.
+pub fn walk_options(args: &MatrixArgs, gait: Gait) -> anyhow::Result<PhysicsWalkOptions> {
     let mut options = match gait {
         Gait::Dynamic => PhysicsWalkOptions::dynamic(),
         Gait::Static => PhysicsWalkOptions::default(),
@@ -225,22 +237,13 @@ fn walk_options(args: &MatrixArgs, gait: Gait) -> anyhow::Result<PhysicsWalkOpti
                 "--pelvis-com-offset {offset:?}: expected three numbers x,y,z (m), e.g. 0.01,0,0"
             );
         };
-        anyhow::ensure!(
-            offset.iter().all(|v| v.is_finite()),
-            "--pelvis-com-offset {offset:?}: must be finite"
-        );
         options.mujoco.pelvis_com_offset = [x, y, z];
     }
+    options
+        .mujoco
+        .check()
+        .context("--mass-scale / --pelvis-com-offset")?;
     if let Some(impulse) = args.push_impulse {
-        anyhow::ensure!(
-            args.push_duration.is_finite() && args.push_duration > 0.0,
-            "--push-duration {}: must be a positive number of seconds",
-            args.push_duration
-        );
-        anyhow::ensure!(
-            impulse.is_finite(),
-            "--push-impulse {impulse}: must be finite"
-        );
         options.push = Some(Push {
             step: args.push_step,
             force_n: [0.0, impulse / args.push_duration, 0.0],

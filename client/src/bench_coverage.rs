@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
+use clap::builder::RangedU64ValueParser;
 use stance::learned::coverage::{CoverageRow, DISTANCES, write_fig4};
 use stance::learned::{LearnedOptions, NgramModel, Search, generate_learned};
 use stance::{AffordanceSet, PostProcessor};
@@ -31,10 +32,10 @@ pub struct BenchCoverageArgs {
     pub model: PathBuf,
     /// Sampled sequences per distance and affordance set (seeds 0..N); 0 = the most probable
     /// sequence (beam search) only.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=100_000))]
     pub samples: u64,
-    /// Time every post-processing this many times (0 = no timing).
-    #[arg(long, default_value_t = 0)]
+    /// Time every post-processing this many times (0 = no timing), at most 100000.
+    #[arg(long, default_value_t = 0, value_parser = RangedU64ValueParser::<usize>::new().range(0..=100_000))]
     pub runs: usize,
     /// Write the figure as SVG.
     #[arg(long, value_name = "FILE.svg")]

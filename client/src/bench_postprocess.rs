@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
+use clap::builder::RangedU64ValueParser;
 use serde::Serialize;
 use stance::{AffordanceSet, GenerateOptions, PostProcessedSequence, PostProcessor, generate};
 
@@ -31,8 +32,8 @@ pub struct BenchPostprocessArgs {
     /// URDF to use instead of the config's `urdf` (required for HRP-4).
     #[arg(long, value_name = "PATH")]
     pub urdf: Option<PathBuf>,
-    /// Post-processings per length.
-    #[arg(long, default_value_t = 1000)]
+    /// Post-processings per length, 1-10000000.
+    #[arg(long, default_value_t = 1000, value_parser = RangedU64ValueParser::<usize>::new().range(1..=10_000_000))]
     pub runs: usize,
     /// Support affordances of the generated walks.
     #[arg(long, default_value = "feet", value_name = "SET")]

@@ -16,6 +16,7 @@ use shm_types::process::Physics;
 use shm_types::{ClockMode, DaemonState, DaemonStatus, LatencySummary, RuntimeConfig};
 use stance::{Gait, WalkRequest};
 
+use crate::args::{DISTANCE_M, RATE_HZ};
 use crate::daemon_client::connect_when_fresh;
 use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
 use crate::evaluate::truth::judged_outcome;
@@ -50,8 +51,8 @@ pub struct DemoArgs {
     /// Robot to walk.
     #[arg(long, value_enum, default_value = "armar4")]
     pub robot: DemoRobot,
-    /// Distance to walk forward (m).
-    #[arg(long, default_value_t = 1.0)]
+    /// Distance to walk forward (m), 0.01-1000.
+    #[arg(long, default_value_t = 1.0, value_parser = DISTANCE_M.parser())]
     pub distance: f64,
     /// Simulator of the started `walk-sim`: kinematic or mujoco.
     #[arg(long, default_value = "kinematic")]
@@ -59,8 +60,8 @@ pub struct DemoArgs {
     /// Clock of the started processes: realtime (at the config's rate) or lockstep (fast).
     #[arg(long, default_value = "realtime")]
     pub clock: ClockMode,
-    /// Control rate of the started processes, overriding the config's.
-    #[arg(long)]
+    /// Control rate of the started processes, overriding the config's (Hz, 10-10000).
+    #[arg(long, value_parser = RATE_HZ.parser())]
     pub rate_hz: Option<f64>,
     /// Robot config (default: configs/<robot>.toml in the current directory or the source tree).
     #[arg(long)]

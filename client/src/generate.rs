@@ -4,9 +4,11 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
+use kinematics::bounds::Range;
 use stance::learned::SourceArgs;
 use stance::{AffordanceSet, GenerateOptions};
 
+use crate::args::DISTANCE_M;
 use crate::postprocess::{ParamOverrides, load_robot};
 
 /// Arguments of `walkctl generate`.
@@ -20,7 +22,7 @@ pub struct GenerateArgs {
     pub urdf: Option<PathBuf>,
     /// Distance the post-processed walk should cover [m]; the raw sequence is generated for
     /// D / scf (the paper's rule), with scf from `[postprocess]` or `--scf`.
-    #[arg(long, value_name = "D")]
+    #[arg(long, value_name = "D", value_parser = DISTANCE_M.parser())]
     pub distance: f64,
     /// Generate exactly D metres (no division by scf).
     #[arg(long)]
@@ -44,10 +46,12 @@ pub struct GenerateArgs {
     pub source: SourceArgs,
 }
 
+/// `FROM:TO`, each a point of the path: in [0, the longest walk].
 fn parse_interval(text: &str) -> Result<[f64; 2], String> {
     let (from, to) = text.split_once(':').ok_or("expected FROM:TO, e.g. 0:2.5")?;
-    let parse = |s: &str| s.trim().parse::<f64>().map_err(|e| format!("`{s}`: {e}"));
-    Ok([parse(from)?, parse(to)?])
+    let parse = Range::new(0.0, DISTANCE_M.max).parser();
+    let point = |s: &str| parse(s).map_err(|e| format!("`{s}`: {e}"));
+    Ok([point(from)?, point(to)?])
 }
 
 /// Runs `walkctl generate`.

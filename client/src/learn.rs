@@ -5,6 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use clap::builder::RangedU64ValueParser;
+use kinematics::bounds::Range;
 use stance::learned::realism::{WalkStatistics, of_generated, of_keyframes};
 use stance::learned::{
     NgramModel, Query, Search, SegmentOptions, TrainOptions, generate_tokens, load_folder, segment,
@@ -20,14 +22,14 @@ pub struct LearnArgs {
     /// Where to write the model.
     #[arg(short, long, value_name = "MODEL.json")]
     pub output: PathBuf,
-    /// Order n of the n-gram.
-    #[arg(long, default_value_t = 3)]
+    /// Order n of the n-gram, 1-10.
+    #[arg(long, default_value_t = 3, value_parser = RangedU64ValueParser::<usize>::new().range(1..=10))]
     pub order: usize,
-    /// Absolute discount of the smoothing, in (0, 1).
-    #[arg(long, default_value_t = 0.75)]
+    /// Absolute discount of the smoothing, 0.01-0.99.
+    #[arg(long, default_value_t = 0.75, value_parser = Range::new(0.01, 0.99).parser())]
     pub discount: f64,
-    /// Largest number of pose clusters per taxonomy class.
-    #[arg(long, default_value_t = 8)]
+    /// Largest number of pose clusters per taxonomy class, 1-1000.
+    #[arg(long, default_value_t = 8, value_parser = RangedU64ValueParser::<usize>::new().range(1..=1000))]
     pub max_clusters: usize,
     /// Do not add left-right mirrored copies of the demonstrations.
     #[arg(long)]

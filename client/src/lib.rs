@@ -5,6 +5,7 @@
 //! library API to a running walkd, [`process`] the one way to start and stop the system's
 //! processes (walkctl, the latency report and the end-to-end tests use it).
 
+pub mod args;
 pub mod bench_coverage;
 pub mod bench_postprocess;
 pub mod control;

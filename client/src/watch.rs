@@ -10,8 +10,8 @@ use crate::daemon_client::{DaemonClient, DaemonTarget, status_text};
 /// Arguments of `walkctl watch`.
 #[derive(Debug, clap::Args)]
 pub struct WatchArgs {
-    /// Give up after this many seconds.
-    #[arg(long, default_value_t = 3600)]
+    /// Give up after this many seconds, 1-604800 (a week).
+    #[arg(long, default_value_t = 3600, value_parser = clap::value_parser!(u64).range(1..=604_800))]
     pub timeout_s: u64,
     #[command(flatten)]
     pub target: DaemonTarget,

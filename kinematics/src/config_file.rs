@@ -58,6 +58,13 @@ pub enum ConfigFileError {
     },
 }
 
+/// A TOML value error as one line that names the key: `toml` keeps the key path out of
+/// [`toml::de::Error::message`] ("invalid value: integer `-1`, expected u32") and adds it on a
+/// line of its own in the error's text; this joins the two ("... expected u32 in `spin_us`").
+pub fn toml_message(error: &toml::de::Error) -> String {
+    error.to_string().trim_end().replace('\n', " ")
+}
+
 impl ConfigFile {
     /// Reads and parses the file at `path`.
     pub fn load(path: &Path) -> Result<Self, ConfigFileError> {
@@ -197,6 +204,21 @@ mod tests {
             let error = file.set(bad).unwrap_err().to_string();
             assert!(error.contains(named) && error.contains("r.toml"), "{error}");
         }
+    }
+
+    #[test]
+    fn a_badly_typed_value_is_described_with_its_key() {
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct Section {
+            spin_us: u32,
+        }
+        let table: toml::Table = "spin_us = -1".parse().unwrap();
+        let error = toml::Value::Table(table).try_into::<Section>().unwrap_err();
+        assert_eq!(
+            toml_message(&error),
+            "invalid value: integer `-1`, expected u32 in `spin_us`"
+        );
     }
 
     #[test]

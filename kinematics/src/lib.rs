@@ -12,6 +12,7 @@
 //! - The CoM Jacobian (3 × (6+n)) maps ν to ċ in the world frame.
 //! - Mimic joints are treated as fixed at their offset; they are not in the joint vector.
 
+pub mod bounds;
 pub mod config_file;
 pub mod configuration;
 pub mod ground;

@@ -33,7 +33,8 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use serde::Deserialize;
 
-use crate::config_file::{ConfigFile, ConfigFileError};
+use crate::bounds::{Bound, Number, Range, first_outside};
+use crate::config_file::{ConfigFile, ConfigFileError, toml_message};
 use crate::configuration::Configuration;
 use crate::kinematics::Kinematics;
 use crate::model::{FrameId, LinkId, Model, ModelError, pose_from_xyz_rpy};
@@ -85,6 +86,16 @@ pub struct SoleRectangle {
     pub length: f64,
     /// Extent along the sole frame's y axis (m).
     pub width: f64,
+}
+
+impl SoleRectangle {
+    /// The `[robot] sole` table: each extent, its value and its range (docs/kinematics.md).
+    pub fn bounds(&self) -> [Bound; 2] {
+        [
+            Bound::new("sole.length", self.length, 0.01, 1.0),
+            Bound::new("sole.width", self.width, 0.01, 1.0),
+        ]
+    }
 }
 
 /// Joint indices (model order) of each body part, for posture tasks and stance retargeting.
@@ -241,6 +252,12 @@ struct RobotSection {
     standing: BTreeMap<String, f64>,
 }
 
+/// Each coordinate of a configured frame's offset from its link (m): a robot's frames sit on it.
+const FRAME_OFFSET_M: Range = Range::new(-10.0, 10.0);
+
+/// Each roll, pitch and yaw of a configured frame (rad): a turn either way.
+const FRAME_ANGLE_RAD: Range = Range::new(-std::f64::consts::TAU, std::f64::consts::TAU);
+
 /// Soles count as flat when their normals are within this angle (rad) of vertical and their
 /// heights agree to this distance (m).
 const FLAT_TOLERANCE: f64 = 1e-6;
@@ -277,7 +294,7 @@ impl Robot {
             .ok_or_else(|| schema("the section is missing".to_owned()))?
             .clone()
             .try_into()
-            .map_err(|error: toml::de::Error| schema(error.message().to_owned()))?;
+            .map_err(|error: toml::de::Error| schema(toml_message(&error)))?;
         let urdf = match (urdf_override, &section.urdf) {
             (Some(path), _) => path.to_owned(),
             (None, Some(relative)) => file.resolve(relative),
@@ -399,26 +416,30 @@ impl Loader<'_> {
     }
 
     fn check_sole(&self, sole: &SoleRectangle) -> Result<(), RobotError> {
-        for (key, value) in [("sole.length", sole.length), ("sole.width", sole.width)] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(self.invalid(
-                    key,
-                    format!("must be a positive length in metres, got {value}"),
-                ));
-            }
+        match first_outside(&sole.bounds()) {
+            Some(violation) => Err(self.invalid(
+                violation.key,
+                format!(
+                    "{} m {}",
+                    Number(violation.value),
+                    violation.range.requirement()
+                ),
+            )),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     fn frame(&mut self, key: &str, name: &str, spec: &FrameSpec) -> Result<FrameId, RobotError> {
         let link = self.link(&format!("{key}.link"), &spec.link)?;
-        if !spec
-            .translation
-            .iter()
-            .chain(&spec.rpy)
-            .all(|x| x.is_finite())
+        if !spec.translation.iter().all(|&x| FRAME_OFFSET_M.contains(x))
+            || !spec.rpy.iter().all(|&x| FRAME_ANGLE_RAD.contains(x))
         {
-            return Err(self.invalid(key, "translation and rpy must be finite".to_owned()));
+            return Err(self.invalid(
+                key,
+                format!(
+                    "translation must be in {FRAME_OFFSET_M} m and rpy in {FRAME_ANGLE_RAD} rad"
+                ),
+            ));
         }
         let offset = pose_from_xyz_rpy(spec.translation, spec.rpy);
         self.model

@@ -44,6 +44,9 @@ pub struct RuntimeConfig {
     pub max_stances: usize,
 }
 
+/// The longest a watchdog may wait before holding, `watchdog_periods / rate_hz` (s).
+pub const WATCHDOG_MAX_S: f64 = 2.0;
+
 fn default_rate_hz() -> f64 {
     500.0
 }
@@ -81,9 +84,70 @@ pub enum ConfigError {
         /// What is wrong, naming the key.
         message: String,
     },
+    /// A command-line value that replaces a `[runtime]` key is out of range (or makes another
+    /// key so).
+    #[error("{flags}: [runtime]: {message}")]
+    Override {
+        /// The overriding flags and their values (`--rate-hz 1000000000000`).
+        flags: String,
+        /// What is wrong, naming the key.
+        message: String,
+    },
+}
+
+/// Command-line values that replace `[runtime]` keys: the flags of walkd and walk-sim named
+/// after them (`--rate-hz`, `--service-prefix`, `--fifo-priority`, `--cpu`, `--spin-us`). They
+/// are checked like the file's values, the error naming the flags.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RuntimeOverrides {
+    /// `--rate-hz`.
+    pub rate_hz: Option<f64>,
+    /// `--service-prefix`.
+    pub service_prefix: Option<String>,
+    /// `--fifo-priority`.
+    pub fifo_priority: Option<i32>,
+    /// `--cpu`.
+    pub cpu: Option<usize>,
+    /// `--spin-us`.
+    pub spin_us: Option<u32>,
+}
+
+impl RuntimeOverrides {
+    /// `runtime` with the given values in place, checked.
+    pub fn apply(&self, mut runtime: RuntimeConfig) -> Result<RuntimeConfig, ConfigError> {
+        let mut flags = Vec::new();
+        if let Some(rate) = self.rate_hz {
+            runtime.rate_hz = rate;
+            flags.push(format!("--rate-hz {rate}"));
+        }
+        if let Some(prefix) = &self.service_prefix {
+            runtime.service_prefix.clone_from(prefix);
+            flags.push(format!("--service-prefix {prefix}"));
+        }
+        if let Some(priority) = self.fifo_priority {
+            runtime.fifo_priority = Some(priority);
+            flags.push(format!("--fifo-priority {priority}"));
+        }
+        if let Some(cpu) = self.cpu {
+            runtime.cpu = Some(cpu);
+            flags.push(format!("--cpu {cpu}"));
+        }
+        if let Some(spin_us) = self.spin_us {
+            runtime.spin_us = spin_us;
+            flags.push(format!("--spin-us {spin_us}"));
+        }
+        runtime.check().map_err(|message| ConfigError::Override {
+            flags: flags.join(" "),
+            message,
+        })?;
+        Ok(runtime)
+    }
 }
 
 impl RuntimeConfig {
+    /// The range of `rate_hz` (Hz), also of every `--rate-hz`.
+    pub const RATE_HZ: std::ops::RangeInclusive<f64> = 10.0..=10_000.0;
+
     /// Reads the `[runtime]` section (`None`: the file has none); `origin` names the file.
     pub fn from_section(section: Option<&toml::Value>, origin: &str) -> Result<Self, ConfigError> {
         let section = section.ok_or_else(|| ConfigError::MissingSection {
@@ -96,39 +160,100 @@ impl RuntimeConfig {
         let config: Self = section
             .clone()
             .try_into()
-            .map_err(|e: toml::de::Error| invalid(e.message().to_owned()))?;
-        config.validate().map_err(invalid)?;
+            // The error's text names the key of a badly typed value; its message alone does not.
+            .map_err(|e: toml::de::Error| invalid(e.to_string().trim_end().replace('\n', " ")))?;
+        config.check().map_err(invalid)?;
         Ok(config)
     }
 
-    fn validate(&self) -> Result<(), String> {
-        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0 && self.rate_hz <= 10_000.0) {
-            return Err(format!("rate_hz = {} must be in (0, 10000]", self.rate_hz));
+    /// Checks every value against its documented range (docs/ipc.md, "[runtime]") and the
+    /// watchdogs against [`WATCHDOG_MAX_S`]; the error names the key. Run at load
+    /// and again after command-line overrides ([`RuntimeOverrides::apply`]).
+    pub fn check(&self) -> Result<(), String> {
+        for bound in self.bounds() {
+            if let Some(value) = bound.value
+                && !(bound.min <= value && value <= bound.max)
+            {
+                // Integers as written; others (NaN, 1e-300) as Rust reads them.
+                let shown = if value.fract() == 0.0 && value.abs() < 1e16 {
+                    format!("{value:.0}")
+                } else {
+                    format!("{value:?}")
+                };
+                return Err(format!(
+                    "{} = {shown}: must be in [{}, {}]",
+                    bound.key, bound.min, bound.max
+                ));
+            }
         }
-        if !(self.status_rate_hz.is_finite() && self.status_rate_hz > 0.0) {
+        let watchdog_s = f64::from(self.watchdog_periods) / self.rate_hz;
+        if watchdog_s > WATCHDOG_MAX_S {
             return Err(format!(
-                "status_rate_hz = {} must be positive",
-                self.status_rate_hz
+                "watchdog_periods = {} at rate_hz = {} holds only after {watchdog_s} s without a \
+                 sample: must be at most {WATCHDOG_MAX_S} s",
+                self.watchdog_periods, self.rate_hz,
             ));
-        }
-        if self.watchdog_periods == 0 {
-            return Err("watchdog_periods must be at least 1".to_owned());
-        }
-        if self.lockstep_timeout_ms == 0 {
-            return Err("lockstep_timeout_ms must be at least 1".to_owned());
-        }
-        if let Some(priority) = self.fifo_priority
-            && !(1..=99).contains(&priority)
-        {
-            return Err(format!("fifo_priority = {priority} must be in 1..=99"));
-        }
-        if self.max_submission_bytes == 0 || self.max_stances == 0 {
-            return Err("max_submission_bytes and max_stances must be at least 1".to_owned());
         }
         crate::ServiceNames::new(&self.service_prefix)
             .map_err(|e| format!("service_prefix: {e}"))?;
         Ok(())
     }
+
+    /// The section's table: every numeric key, its value and its range, one line a key.
+    pub fn bounds(&self) -> Vec<RuntimeBound> {
+        let bound = |key, value: Option<f64>, min, max| RuntimeBound {
+            key,
+            value,
+            min,
+            max,
+        };
+        let (rate_min, rate_max) = (*Self::RATE_HZ.start(), *Self::RATE_HZ.end());
+        vec![
+            bound("rate_hz", Some(self.rate_hz), rate_min, rate_max),
+            bound("status_rate_hz", Some(self.status_rate_hz), 1.0, 1000.0),
+            bound(
+                "watchdog_periods",
+                Some(self.watchdog_periods.into()),
+                1.0,
+                1000.0,
+            ),
+            bound(
+                "lockstep_timeout_ms",
+                Some(self.lockstep_timeout_ms as f64),
+                1.0,
+                5000.0,
+            ),
+            bound(
+                "fifo_priority",
+                self.fifo_priority.map(f64::from),
+                1.0,
+                99.0,
+            ),
+            // A CPU the affinity mask can name (CPU_SETSIZE).
+            bound("cpu", self.cpu.map(|cpu| cpu as f64), 0.0, 1023.0),
+            bound("spin_us", Some(self.spin_us.into()), 0.0, 10_000.0),
+            bound(
+                "max_submission_bytes",
+                Some(self.max_submission_bytes as f64),
+                1024.0,
+                (1u64 << 30) as f64,
+            ),
+            bound("max_stances", Some(self.max_stances as f64), 1.0, 1e6),
+        ]
+    }
+}
+
+/// One numeric key of `[runtime]`: its value (`None`: an optional key left out) and its range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RuntimeBound {
+    /// The key.
+    pub key: &'static str,
+    /// Its value.
+    pub value: Option<f64>,
+    /// The smallest value allowed.
+    pub min: f64,
+    /// The largest value allowed.
+    pub max: f64,
 }
 
 #[cfg(test)]
@@ -163,5 +288,59 @@ mod tests {
             parse("[robot]\n"),
             Err(ConfigError::MissingSection { .. })
         ));
+    }
+
+    #[test]
+    fn values_outside_their_ranges_are_refused_naming_the_key() {
+        for (key, value) in [
+            ("status_rate_hz", "1e-300"),
+            ("status_rate_hz", "1e300"),
+            ("rate_hz", "1e-3"),
+            ("watchdog_periods", "4294967295"),
+            ("lockstep_timeout_ms", "18446744073709"),
+            ("spin_us", "4294967295"),
+            ("max_stances", "9223372036854775807"),
+            ("max_submission_bytes", "9223372036854775807"),
+            ("cpu", "100000"),
+            ("watchdog_periods", "-1"),
+            ("lockstep_timeout_ms", "1.5"),
+            ("fifo_priority", "1e10"),
+            ("rate_hz", "nan"),
+        ] {
+            let text = format!("[runtime]\nservice_prefix = \"walk/r\"\n{key} = {value}\n");
+            let error = parse(&text).expect_err(&text).to_string();
+            assert!(
+                error.contains("robot.toml") && error.contains(key),
+                "{key} = {value}: {error}"
+            );
+        }
+    }
+
+    #[test]
+    fn overrides_are_checked_like_the_file_and_name_their_flags() {
+        let runtime =
+            parse("[runtime]\nservice_prefix = \"walk/r\"\nwatchdog_periods = 100\n").unwrap();
+        let overrides = |rate_hz| RuntimeOverrides {
+            rate_hz: Some(rate_hz),
+            ..RuntimeOverrides::default()
+        };
+        assert_eq!(
+            overrides(1000.0).apply(runtime.clone()).unwrap().rate_hz,
+            1000.0
+        );
+        for (rate, named) in [
+            (1e12, "rate_hz"),
+            (f64::NAN, "rate_hz"),
+            (20.0, "watchdog_periods"),
+        ] {
+            let error = overrides(rate)
+                .apply(runtime.clone())
+                .unwrap_err()
+                .to_string();
+            assert!(
+                error.starts_with(&format!("--rate-hz {rate}: [runtime]: {named} =")),
+                "{error}"
+            );
+        }
     }
 }

@@ -40,7 +40,7 @@ pub use ports::{
 };
 
 pub use clock::{current_thread_is_fifo, monotonic_ns, sleep_then_spin_until, sleep_until};
-pub use config::{ConfigError, RuntimeConfig};
+pub use config::{ConfigError, RuntimeBound, RuntimeConfig, RuntimeOverrides, WATCHDOG_MAX_S};
 pub use error::ShmError;
 pub use messages::{
     ClockMode, CommandMode, ControlCommand, ControlReply, ControlRequest, DaemonState,

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use shm_types::{
     AdapterPorts, ClockMode, CommandMode, DecodeError, JointCommand, MAX_JOINTS, SensorSample,
-    ShmError, monotonic_ns, sleep_then_spin_until,
+    ShmError, monotonic_ns, sleep_then_spin_until, sleep_until,
 };
 
 use crate::RobotIo;
@@ -204,13 +204,12 @@ impl<R: RobotIo> Adapter<'_, R> {
     }
 
     fn run_realtime(&mut self, should_stop: &dyn Fn() -> bool) -> Result<(), ShmError> {
-        let period = (1e9 / self.options.rate_hz) as u64;
+        let period = ((1e9 / self.options.rate_hz) as u64).max(1);
         let spin = (self.options.spin.as_nanos() as u64).min(period);
         let mut stale_periods = 0;
         self.publish()?;
         let mut deadline = monotonic_ns() + period;
-        while !should_stop() {
-            sleep_then_spin_until(deadline, spin);
+        while wait_for_deadline(deadline, spin, should_stop) {
             if self.take_command(false)? {
                 stale_periods = 0;
             } else {
@@ -251,6 +250,23 @@ impl<R: RobotIo> Adapter<'_, R> {
             }
         }
         Ok(())
+    }
+}
+
+/// Sleeps until `deadline_ns` (busy-waiting its last `spin_ns`) in waits of at most
+/// [`MAX_WAIT`], so a stop request is seen however long the period; false if one came.
+fn wait_for_deadline(deadline_ns: u64, spin_ns: u64, should_stop: &dyn Fn() -> bool) -> bool {
+    let slice = MAX_WAIT.as_nanos() as u64;
+    loop {
+        if should_stop() {
+            return false;
+        }
+        let now = monotonic_ns();
+        if deadline_ns.saturating_sub(now) <= slice + spin_ns {
+            sleep_then_spin_until(deadline_ns, spin_ns);
+            return true;
+        }
+        sleep_until(now + slice);
     }
 }
 

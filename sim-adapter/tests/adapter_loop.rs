@@ -30,10 +30,11 @@ impl RobotIo for IdealServo {
     }
 }
 
-/// Starts an adapter thread on `prefix`; returns its stop flag and handle.
+/// Starts an adapter thread on `prefix` at `rate_hz`; returns its stop flag and handle.
 fn start_adapter(
     prefix: &str,
     clock: ClockMode,
+    rate_hz: f64,
 ) -> (
     Arc<AtomicBool>,
     std::thread::JoinHandle<sim_adapter::AdapterReport>,
@@ -48,7 +49,7 @@ fn start_adapter(
         };
         let options = AdapterOptions {
             clock,
-            rate_hz: 500.0,
+            rate_hz,
             watchdog_periods: 5,
             lockstep_timeout: Duration::from_millis(50),
             spin: Duration::ZERO,
@@ -86,7 +87,7 @@ fn answer(daemon: &DaemonLoopPorts, sample: &SensorSample, q0: f64) {
 fn check(clock: ClockMode, test: &str) {
     let prefix = format!("walk-test/sim-adapter/{test}/{}", std::process::id());
     let daemon = DaemonLoopPorts::open(&ServiceNames::new(&prefix).unwrap(), "daemon").unwrap();
-    let (stop, adapter) = start_adapter(&prefix, clock);
+    let (stop, adapter) = start_adapter(&prefix, clock, 500.0);
     let mut sample = SensorSample::ZERO;
 
     next_sample(&daemon, &mut sample);
@@ -142,4 +143,23 @@ fn lockstep_adapter_follows_holds_when_stale_and_resumes() {
 #[test]
 fn realtime_adapter_follows_holds_when_stale_and_resumes() {
     check(ClockMode::Realtime, "realtime");
+}
+
+/// A stop request ends the loop within its longest single wait, whatever the period: a period
+/// of 1000 s (1 mHz) is not slept through.
+#[test]
+fn a_slow_realtime_adapter_stops_when_asked_not_at_its_next_period() {
+    let prefix = format!("walk-test/sim-adapter/slow/{}", std::process::id());
+    let daemon = DaemonLoopPorts::open(&ServiceNames::new(&prefix).unwrap(), "daemon").unwrap();
+    let (stop, adapter) = start_adapter(&prefix, ClockMode::Realtime, 1e-3);
+    let mut sample = SensorSample::ZERO;
+    next_sample(&daemon, &mut sample);
+    stop.store(true, Ordering::Relaxed);
+    let (done, ended) = std::sync::mpsc::channel();
+    std::thread::spawn(move || done.send(adapter.join()).unwrap());
+    let report = ended
+        .recv_timeout(Duration::from_secs(2))
+        .expect("the adapter still sleeps 2 s after the stop request")
+        .unwrap();
+    assert_eq!(report.samples, 1);
 }

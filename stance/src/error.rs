@@ -71,6 +71,12 @@ pub enum FormatError {
     /// NaN or an infinity (written as `NaN`/`Infinity` or as an overflowing number).
     #[error("{location}: non-finite number (NaN or infinity) is not allowed")]
     NonFinite { location: Location },
+    /// The document is JSON, but not an object (serde would read an array as the fields in
+    /// order and complain about the first one's type).
+    #[error(
+        "a stance file is a JSON object ({{\"format_version\": 1, \"kind\": ..., \"stances\": [...]}}), not {found}"
+    )]
+    NotAnObject { found: &'static str },
     /// A `format_version` this code does not read.
     #[error(
         "field `format_version`: version {found} is not supported (this build reads {supported})"

@@ -14,7 +14,8 @@
 //! ```
 //! `targets` is present exactly in post-processed files; so is the optional `"gait": "static" |
 //! "dynamic"`, the gait whose limits post-processed the sequence and that walks it (absent: the
-//! robot config's default). `root_orientation` defaults to the identity. Unknown fields are errors. Quaternions are `[x, y, z, w]`.
+//! robot config's default). `root_orientation` defaults to the identity. Unknown fields are errors;
+//! a top-level value other than an object is refused as such. Quaternions are `[x, y, z, w]`.
 
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
@@ -240,7 +241,27 @@ fn is_non_finite_literal(token: &str) -> bool {
         .any(|t| unsigned.eq_ignore_ascii_case(t))
 }
 
-/// Maps a serde_json error to a located [`FormatError`].
+/// Refuses a document whose top-level value is not an object before serde reads it: serde reads a
+/// struct from an array too (the fields in order), so an array would be refused for the type of
+/// its first element, or even accepted.
+fn top_level_object(text: &str) -> Result<(), FormatError> {
+    if text.trim_start().starts_with('{') {
+        return Ok(());
+    }
+    // Not an object: only now is it worth a parse, to name what it is (or where it breaks).
+    let value: serde_json::Value =
+        serde_json::from_str(text).map_err(|error| json_error(text, error))?;
+    let found = match value {
+        serde_json::Value::Array(_) => "an array",
+        serde_json::Value::String(_) => "a string",
+        serde_json::Value::Number(_) => "a number",
+        serde_json::Value::Bool(_) => "a boolean",
+        serde_json::Value::Null => "null",
+        serde_json::Value::Object(_) => return Ok(()),
+    };
+    Err(FormatError::NotAnObject { found })
+}
+
 /// The number of stances in a stance file, counted without building them: a reader can bound a
 /// submission before it parses it (the pass skips every value and allocates nothing per stance).
 pub fn count_stances(text: &str) -> Result<usize, FormatError> {
@@ -269,6 +290,7 @@ pub fn count_stances(text: &str) -> Result<usize, FormatError> {
         }
         d.deserialize_seq(Counter)
     }
+    top_level_object(text)?;
     serde_json::from_str::<Count>(text)
         .map(|count| count.stances)
         .map_err(|error| json_error(text, error))
@@ -306,6 +328,7 @@ fn file_dto<'a>(
     }
 }
 
+/// Maps a serde_json error to a located [`FormatError`].
 fn json_error(text: &str, error: serde_json::Error) -> FormatError {
     let (line, column) = (error.line(), error.column());
     let offset = offset_of(text, line, column);
@@ -340,6 +363,7 @@ fn json_error(text: &str, error: serde_json::Error) -> FormatError {
 }
 
 fn parse_file(text: &str, expected: Kind) -> Result<FileDto, FormatError> {
+    top_level_object(text)?;
     let file: FileDto = serde_json::from_str(text).map_err(|error| {
         match serde_json::from_str::<VersionProbe>(text) {
             Ok(probe) if probe.format_version != u64::from(FORMAT_VERSION) => {

@@ -3,8 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use kinematics::ConfigFile;
-use kinematics::ConfigFileError;
+use kinematics::bounds::{Bound, Number, first_outside};
+use kinematics::config_file::toml_message;
+use kinematics::{ConfigFile, ConfigFileError};
 use serde::{Deserialize, Serialize};
 
 /// How a run of contacts of one end-effector is made static (pass 2).
@@ -20,8 +21,9 @@ pub enum ContactUnification {
 
 /// How a sequence is walked: each gait post-processes with its own limits (a dynamic walk
 /// takes longer steps than a statically stable one), so the choice is made before
-/// post-processing and travels with the sequence to the controller.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+/// post-processing and travels with the sequence to the controller. Read from its name only
+/// (anything else is refused as not `"static"` or `"dynamic"`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Gait {
     /// Quasi-static: the CoM stays over the support polygon; contact changes wait for targets
@@ -70,6 +72,25 @@ impl Gait {
             .ok_or_else(|| fail(format!("`default` must be a string, not {value}")))?
             .parse()
             .map_err(|e: String| fail(format!("`default`: {e}")))
+    }
+}
+
+impl<'de> Deserialize<'de> for Gait {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        /// Takes a name; says what is expected instead of anything else (serde's derived enum
+        /// reader answers a number with "expected value", as if the JSON were broken).
+        struct Name;
+        impl serde::de::Visitor<'_> for Name {
+            type Value = Gait;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("\"static\" or \"dynamic\"")
+            }
+            fn visit_str<E: serde::de::Error>(self, name: &str) -> Result<Gait, E> {
+                name.parse()
+                    .map_err(|_| E::invalid_value(serde::de::Unexpected::Str(name), &self))
+            }
+        }
+        deserializer.deserialize_any(Name)
     }
 }
 
@@ -191,7 +212,7 @@ impl PostProcessParams {
                     .map_err(|e: toml::de::Error| ParamsError::Key {
                         path: path.to_owned(),
                         section,
-                        message: e.message().to_owned(),
+                        message: toml_message(&e),
                     })?;
             params.validate(&origin)?;
             Ok::<_, ParamsError>(params)
@@ -210,52 +231,50 @@ impl PostProcessParams {
         })
     }
 
-    /// Checks every value's domain; `origin` names the source in the error (file or "--option").
+    /// Checks every value against its documented range (docs/stance.md, "[postprocess]") and
+    /// each minimum against its maximum; `origin` names the source in the error (the file, or
+    /// the file with command-line overrides).
     pub fn validate(&self, origin: &str) -> Result<(), ParamsError> {
-        let invalid = |key: &'static str, message: &str| {
+        let invalid = |key: &'static str, message: String| {
             Err(ParamsError::Invalid {
                 origin: origin.to_owned(),
                 key,
-                message: message.to_owned(),
+                message,
             })
         };
-        let all = [
-            ("scf", self.scf),
-            ("s_max", self.s_max),
-            ("o_min", self.o_min),
-            ("o_max", self.o_max),
-            ("alpha_x", self.alpha_x),
-            ("alpha_y", self.alpha_y),
-            ("alpha_z", self.alpha_z),
-            ("h_min", self.h_min),
-            ("h_max", self.h_max),
-        ];
-        if let Some((key, _)) = all.iter().find(|(_, v)| !v.is_finite() || *v < 0.0) {
-            return invalid(key, "must be a finite number ≥ 0");
-        }
-        if self.scf <= 0.0 || self.scf > 1.0 {
-            return invalid("scf", "must be in (0, 1]");
-        }
-        if self.s_max <= 0.0 {
-            return invalid("s_max", "must be > 0");
+        if let Some(violation) = first_outside(&self.bounds()) {
+            return invalid(
+                violation.key,
+                format!(
+                    "{} {}",
+                    Number(violation.value),
+                    violation.range.requirement()
+                ),
+            );
         }
         if self.o_min > self.o_max {
-            return invalid("o_min", "must not exceed o_max");
+            return invalid("o_min", "must not exceed o_max".to_owned());
         }
         if self.h_min > self.h_max {
-            return invalid("h_min", "must not exceed h_max");
-        }
-        let right_angle = std::f64::consts::FRAC_PI_2;
-        for (key, alpha) in [
-            ("alpha_x", self.alpha_x),
-            ("alpha_y", self.alpha_y),
-            ("alpha_z", self.alpha_z),
-        ] {
-            if alpha >= right_angle {
-                return invalid(key, "must be below π/2");
-            }
+            return invalid("h_min", "must not exceed h_max".to_owned());
         }
         Ok(())
+    }
+
+    /// The section's table: every numeric key, its value and its range, one line a key.
+    pub fn bounds(&self) -> Vec<Bound> {
+        vec![
+            Bound::new("scf", self.scf, 0.01, 1.0),
+            Bound::new("s_max", self.s_max, 0.01, 2.0),
+            Bound::new("o_min", self.o_min, 0.0, 1.0),
+            Bound::new("o_max", self.o_max, 0.0, 1.0),
+            // Below π/2: a swing foot turned upright or further is no foot to step on.
+            Bound::new("alpha_x", self.alpha_x, 0.0, 1.5),
+            Bound::new("alpha_y", self.alpha_y, 0.0, 1.5),
+            Bound::new("alpha_z", self.alpha_z, 0.0, 1.5),
+            Bound::new("h_min", self.h_min, 0.0, 0.5),
+            Bound::new("h_max", self.h_max, 0.0, 0.5),
+        ]
     }
 
     /// The swing-foot rotation limits `[α_x, α_y, α_z]`.

@@ -266,3 +266,49 @@ fn a_post_processed_file_carries_the_gait_it_was_post_processed_for() {
         "{err}"
     );
 }
+
+#[test]
+fn a_gait_that_is_not_a_name_is_refused_naming_the_field_and_the_choices() {
+    let (robot, _) = common::jvrc1();
+    let mut value: Value = serde_json::from_str(&processed().to_json_string()).unwrap();
+    for gait in [
+        json!(1),
+        json!(true),
+        json!(["dynamic"]),
+        json!({"dynamic": 1}),
+    ] {
+        value["gait"] = gait.clone();
+        let err = PostProcessedSequence::from_json_str(&value.to_string(), robot).unwrap_err();
+        let text = err.to_string();
+        assert!(
+            matches!(&err, FormatError::Structure { location, .. } if *location == Location::file("gait"))
+                && text.contains("\"static\" or \"dynamic\""),
+            "gait {gait}: {text}"
+        );
+    }
+}
+
+#[test]
+fn a_file_that_is_not_an_object_is_refused_as_such() {
+    let (robot, _) = common::jvrc1();
+    for (text, found) in [
+        ("[1, 2, 3]", "an array"),
+        ("[]", "an array"),
+        ("  \"stances\"", "a string"),
+        ("42", "a number"),
+        ("true", "a boolean"),
+        ("null", "null"),
+    ] {
+        for err in [
+            PostProcessedSequence::from_json_str(text, robot).unwrap_err(),
+            RawSequence::from_json_str(text, robot).unwrap_err(),
+            stance::format::count_stances(text).unwrap_err(),
+        ] {
+            let message = err.to_string();
+            assert!(
+                message.contains("a stance file is a JSON object") && message.contains(found),
+                "{text}: {message}"
+            );
+        }
+    }
+}

@@ -19,6 +19,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use clap::Parser;
+use client::args::RATE_HZ;
 use client::process::{Launch, Process, Processes, executable_dir};
 use kinematics::ConfigFile;
 use kinematics::robot::Robot;
@@ -35,21 +36,22 @@ struct Args {
     /// Robot config.
     #[arg(long, default_value = "configs/armar4.toml")]
     config: PathBuf,
-    /// Length of each run.
-    #[arg(long, default_value_t = 60)]
+    /// Length of each run (s, 1-86400).
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u64).range(1..=86_400))]
     seconds: u64,
-    /// Control rates to measure (Hz).
-    #[arg(long, value_delimiter = ',', default_value = "500,1000")]
+    /// Control rates to measure (Hz, each 10-10000).
+    #[arg(long, value_delimiter = ',', default_value = "500,1000", value_parser = RATE_HZ.parser())]
     rates: Vec<f64>,
     /// Load conditions to measure at each rate.
     #[arg(long, value_delimiter = ',', default_value = "idle,busy")]
     loads: Vec<Load>,
-    /// walkd's busy-wait time around each expected sample (µs), overriding `[runtime] spin_us`.
-    #[arg(long)]
+    /// walkd's busy-wait time around each expected sample (µs, 0-10000), overriding
+    /// `[runtime] spin_us`.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=10_000))]
     spin_us: Option<u32>,
-    /// SCHED_FIFO priority for walkd's control thread (degrades with a warning if not
+    /// SCHED_FIFO priority for walkd's control thread, 1-99 (degrades with a warning if not
     /// permitted); walk-sim then runs one below it under `chrt -f`, like a real-time adapter.
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(i32).range(1..=99))]
     fifo_priority: Option<i32>,
     /// Internal: burn one CPU until killed (the load generator).
     #[arg(long, hide = true)]

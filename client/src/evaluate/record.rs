@@ -5,6 +5,8 @@
 use serde::{Serialize, Serializer};
 use stance::{AffordanceSet, WalkRequest};
 
+use crate::args::DISTANCE_M;
+
 /// The cells of the matrix a command walks: affordance sets × distances × runs (the command-line
 /// arguments both matrix commands share).
 #[derive(Debug, Clone, clap::Args)]
@@ -16,11 +18,12 @@ pub struct MatrixCells {
         default_value = "feet,feet+left-hand,feet+right-hand"
     )]
     pub affordances: Vec<AffordanceSet>,
-    /// Distances to walk (m).
-    #[arg(long, value_delimiter = ',', default_value = "1,5")]
+    /// Distances to walk (m, each 0.01-1000).
+    #[arg(long, value_delimiter = ',', default_value = "1,5", value_parser = DISTANCE_M.parser())]
     pub distances: Vec<f64>,
-    /// Runs per affordance set and distance; run i uses generator seed `first_seed + i`.
-    #[arg(long, default_value_t = 10)]
+    /// Runs per affordance set and distance, 1-100000; run i uses generator seed
+    /// `first_seed + i`.
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub runs: u64,
     /// Seed of the first run.
     #[arg(long, default_value_t = 0)]
@@ -29,7 +32,7 @@ pub struct MatrixCells {
 
 impl MatrixCells {
     /// Every walk, in matrix order: affordance set, then distance, then seed. Refuses no runs,
-    /// no cells, and distances that are not positive.
+    /// no cells, distances outside their range and seeds past `u64::MAX`.
     pub fn requests(&self) -> anyhow::Result<Vec<WalkRequest>> {
         anyhow::ensure!(self.runs > 0, "--runs must be at least 1");
         anyhow::ensure!(
@@ -37,9 +40,17 @@ impl MatrixCells {
             "--affordances and --distances need at least one value each"
         );
         anyhow::ensure!(
-            self.distances.iter().all(|d| d.is_finite() && *d > 0.0),
-            "--distances {:?}: must be positive numbers of metres",
-            self.distances
+            self.distances.iter().all(|&d| DISTANCE_M.contains(d)),
+            "--distances {:?}: each {}",
+            self.distances,
+            DISTANCE_M.requirement()
+        );
+        anyhow::ensure!(
+            self.first_seed.checked_add(self.runs - 1).is_some(),
+            "--first-seed {} with --runs {}: the last seed would pass {}",
+            self.first_seed,
+            self.runs,
+            u64::MAX
         );
         Ok(self
             .affordances

@@ -35,6 +35,8 @@ use foxglove::Context;
 use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::RuntimeConfig;
+
+use crate::args::DURATION_S;
 use shm_types::process::{install_termination_handler, termination_requested};
 
 pub use live::LiveView;
@@ -79,8 +81,8 @@ pub struct RecordArgs {
     /// The MCAP file to write (replaced if it exists).
     #[arg(short = 'o', long, value_name = "FILE")]
     pub output: PathBuf,
-    /// Stop after this many seconds (default: at SIGINT / SIGTERM).
-    #[arg(long, value_name = "S")]
+    /// Stop after this many seconds, 0.01-1e6 (default: at SIGINT / SIGTERM).
+    #[arg(long, value_name = "S", value_parser = DURATION_S.parser())]
     pub duration: Option<f64>,
     /// Print the summary as one JSON object.
     #[arg(long)]
@@ -98,8 +100,8 @@ pub struct ViewArgs {
     /// Port of the Foxglove WebSocket server.
     #[arg(long, default_value_t = 8765)]
     pub port: u16,
-    /// Stop after this many seconds (default: at SIGINT / SIGTERM).
-    #[arg(long, value_name = "S")]
+    /// Stop after this many seconds, 0.01-1e6 (default: at SIGINT / SIGTERM).
+    #[arg(long, value_name = "S", value_parser = DURATION_S.parser())]
     pub duration: Option<f64>,
     /// Also record to this MCAP file.
     #[arg(long, value_name = "FILE")]
@@ -136,6 +138,11 @@ impl Recorder {
         })
     }
 
+    /// Whether a write to the file failed: the recording is over (see [`Recorder::finish`]).
+    pub fn failed(&self) -> bool {
+        self.recording.failed()
+    }
+
     /// Stops observing, writes the observer's report as the metadata record `observer` and
     /// finishes the file.
     pub fn finish(self) -> anyhow::Result<RecorderOutcome> {
@@ -153,21 +160,20 @@ impl Recorder {
     }
 }
 
-/// Waits until `duration` (if any) passes or SIGINT / SIGTERM arrives.
-fn wait_for_end(duration: Option<f64>) -> anyhow::Result<()> {
-    if let Some(d) = duration {
-        anyhow::ensure!(d.is_finite() && d > 0.0, "--duration {d} must be positive");
-    }
+/// Waits until `duration` (if any) passes, SIGINT / SIGTERM arrives or the recording `failed`.
+fn wait_for_end(duration: Option<f64>, failed: impl Fn() -> bool) {
     install_termination_handler();
     let start = Instant::now();
-    while !termination_requested() && duration.is_none_or(|d| start.elapsed().as_secs_f64() < d) {
+    while !termination_requested()
+        && !failed()
+        && duration.is_none_or(|d| start.elapsed().as_secs_f64() < d)
+    {
         std::thread::sleep(Duration::from_millis(20));
     }
-    Ok(())
 }
 
-/// `walkctl record`: records the daemon's streams to an MCAP file until the duration ends or a
-/// signal arrives, then prints what the file holds.
+/// `walkctl record`: records the daemon's streams to an MCAP file until the duration ends, a
+/// signal arrives or a write fails, then prints what the file holds (or why it failed).
 pub fn run_record(args: &RecordArgs) -> anyhow::Result<()> {
     let (prefix, robot) = args.target.load()?;
     let recorder = Recorder::start(&prefix, robot, &args.output)?;
@@ -179,7 +185,7 @@ pub fn run_record(args: &RecordArgs) -> anyhow::Result<()> {
                 .map_or_else(|| " until Ctrl-C".to_owned(), |d| format!(" for {d} s"))
         );
     }
-    wait_for_end(args.duration)?;
+    wait_for_end(args.duration, || recorder.failed());
     let outcome = recorder.finish()?;
     print_outcome(&outcome, args.json);
     Ok(())
@@ -232,7 +238,9 @@ pub fn run_view(args: &ViewArgs) -> anyhow::Result<()> {
         args.host,
         live.port()
     );
-    wait_for_end(args.duration)?;
+    wait_for_end(args.duration, || {
+        recording.as_ref().is_some_and(Recording::failed)
+    });
     let report = observer.finish()?;
     live.stop();
     if let Some(recording) = recording {

@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+use kinematics::bounds::{Bound, Number, first_outside};
+use kinematics::config_file::toml_message;
 use kinematics::{ConfigFile, ConfigFileError};
 use serde::Deserialize;
 
@@ -213,8 +215,8 @@ pub enum ConfigError {
         /// What is wrong, naming the key.
         message: String,
     },
-    /// A value is out of its meaningful range.
-    #[error("{origin}: [{section}] {key} = {value}: {requirement}")]
+    /// A value is out of its documented range.
+    #[error("{origin}: [{section}] {key} = {}: {requirement}", Number(*value))]
     Value {
         /// File (or "<table>") the section came from.
         origin: String,
@@ -225,7 +227,7 @@ pub enum ConfigError {
         /// Its value.
         value: f64,
         /// What it must satisfy.
-        requirement: &'static str,
+        requirement: String,
     },
 }
 
@@ -250,110 +252,157 @@ impl ControllerConfig {
                 .map_err(|e: toml::de::Error| ConfigError::Section {
                     origin: origin.clone(),
                     section: SECTION,
-                    message: e.message().to_owned(),
+                    message: toml_message(&e),
                 })?;
         config.validate(&origin)?;
         Ok(config)
     }
 
-    /// Checks every value is finite and in range; `origin` names the file in the error.
+    /// Checks every value against its documented range (docs/controller.md, "[controller]");
+    /// `origin` names the file in the error.
     pub fn validate(&self, origin: &str) -> Result<(), ConfigError> {
-        let positive = [
-            ("com_weight", self.com_weight),
-            ("foot_weight", self.foot_weight),
-            ("hand_weight", self.hand_weight),
-            ("torso_weight", self.torso_weight),
-            ("posture_weight", self.posture_weight),
-            ("regularization", self.regularization),
-            ("com_gain", self.com_gain),
-            ("pose_gain", self.pose_gain),
-            ("torso_gain", self.torso_gain),
-            ("posture_gain", self.posture_gain),
-            ("max_base_speed", self.max_base_speed),
-            ("max_base_tilt_speed", self.max_base_tilt_speed),
-            (
+        check(&self.bounds(), origin, SECTION)
+    }
+
+    /// The section's table: every numeric key, its value and its range, one line a key.
+    pub fn bounds(&self) -> Vec<Bound> {
+        let ticks = f64::from(self.touchdown_debounce_ticks);
+        vec![
+            Bound::new("com_weight", self.com_weight, 1e-6, 1e6),
+            Bound::new("foot_weight", self.foot_weight, 1e-6, 1e6),
+            Bound::new("hand_weight", self.hand_weight, 1e-6, 1e6),
+            Bound::new("torso_weight", self.torso_weight, 1e-6, 1e6),
+            Bound::new("posture_weight", self.posture_weight, 1e-6, 1e6),
+            Bound::new("unload_foot_weight", self.unload_foot_weight, 1e-6, 1e6),
+            Bound::new("regularization", self.regularization, 1e-12, 1.0),
+            Bound::new("com_gain", self.com_gain, 0.01, 1000.0),
+            Bound::new("pose_gain", self.pose_gain, 0.01, 1000.0),
+            Bound::new("torso_gain", self.torso_gain, 0.01, 1000.0),
+            Bound::new("posture_gain", self.posture_gain, 0.01, 1000.0),
+            Bound::new("support_gain", self.support_gain, 0.01, 1000.0),
+            Bound::new(
+                "joint_limit_margin_rad",
+                self.joint_limit_margin_rad,
+                0.0,
+                0.5,
+            ),
+            Bound::new("velocity_limit_scale", self.velocity_limit_scale, 0.01, 1.0),
+            Bound::new("max_base_speed", self.max_base_speed, 1e-3, 10.0),
+            Bound::new("max_base_tilt_speed", self.max_base_tilt_speed, 1e-3, 10.0),
+            Bound::new(
                 "max_anchor_correction_speed",
                 self.max_anchor_correction_speed,
+                1e-4,
+                10.0,
             ),
-            (
+            Bound::new(
                 "max_anchor_correction_angular_speed",
                 self.max_anchor_correction_angular_speed,
+                1e-4,
+                100.0,
             ),
-            ("support_gain", self.support_gain),
-            ("com_speed", self.com_speed),
-            ("swing_speed", self.swing_speed),
-            ("swing_angular_speed", self.swing_angular_speed),
-            ("min_motion_s", self.min_motion_s),
-            ("lift_height_m", self.lift_height_m),
-            ("lower_speed", self.lower_speed),
-            ("com_tolerance_m", self.com_tolerance_m),
-            ("position_tolerance_m", self.position_tolerance_m),
-            ("orientation_tolerance_rad", self.orientation_tolerance_rad),
-            ("via_position_tolerance_m", self.via_position_tolerance_m),
-            (
+            Bound::new("support_margin_m", self.support_margin_m, 0.0, 0.2),
+            Bound::new("com_speed", self.com_speed, 1e-3, 2.0),
+            Bound::new("swing_speed", self.swing_speed, 1e-3, 5.0),
+            Bound::new("swing_angular_speed", self.swing_angular_speed, 1e-3, 20.0),
+            Bound::new("min_motion_s", self.min_motion_s, 0.01, 10.0),
+            Bound::new("lift_height_m", self.lift_height_m, 1e-3, 0.5),
+            Bound::new("approach_height_m", self.approach_height_m, 0.0, 0.5),
+            Bound::new("lower_speed", self.lower_speed, 1e-3, 1.0),
+            Bound::new("lower_overshoot_m", self.lower_overshoot_m, 0.0, 0.1),
+            Bound::new("unload_lift_m", self.unload_lift_m, 0.0, 0.1),
+            Bound::new("com_tolerance_m", self.com_tolerance_m, 1e-4, 0.5),
+            Bound::new("position_tolerance_m", self.position_tolerance_m, 1e-4, 0.5),
+            Bound::new(
+                "orientation_tolerance_rad",
+                self.orientation_tolerance_rad,
+                1e-4,
+                1.5,
+            ),
+            Bound::new(
+                "via_position_tolerance_m",
+                self.via_position_tolerance_m,
+                1e-4,
+                0.5,
+            ),
+            Bound::new(
                 "via_orientation_tolerance_rad",
                 self.via_orientation_tolerance_rad,
+                1e-4,
+                1.5,
             ),
-            ("hand_position_tolerance_m", self.hand_position_tolerance_m),
-            (
+            Bound::new(
+                "hand_position_tolerance_m",
+                self.hand_position_tolerance_m,
+                1e-4,
+                0.5,
+            ),
+            Bound::new(
                 "hand_orientation_tolerance_rad",
                 self.hand_orientation_tolerance_rad,
+                1e-4,
+                1.5,
             ),
-            ("phase_timeout_s", self.phase_timeout_s),
-            ("max_step_m", self.max_step_m),
-            ("command_lead_max_rad", self.command_lead_max_rad),
-            ("unload_foot_weight", self.unload_foot_weight),
-            ("tipping_detection_rad", self.tipping_detection_rad),
-            ("joint_limit_tolerance_rad", self.joint_limit_tolerance_rad),
-            ("workspace_radius_m", self.workspace_radius_m),
-            ("workspace_depth_m", self.workspace_depth_m),
-            ("workspace_height_m", self.workspace_height_m),
-            ("max_target_step_m", self.max_target_step_m),
-            ("max_phase_s", self.max_phase_s),
-            ("unloaded_max_s", self.unloaded_max_s),
-        ];
-        let non_negative = [
-            ("joint_limit_margin_rad", self.joint_limit_margin_rad),
-            ("support_margin_m", self.support_margin_m),
-            ("approach_height_m", self.approach_height_m),
-            ("lower_overshoot_m", self.lower_overshoot_m),
-            ("unload_lift_m", self.unload_lift_m),
-        ];
-        let fractions = [
-            ("velocity_limit_scale", self.velocity_limit_scale),
-            ("release_force_fraction", self.release_force_fraction),
-            ("touchdown_force_fraction", self.touchdown_force_fraction),
-            (
+            Bound::new(
+                "release_force_fraction",
+                self.release_force_fraction,
+                1e-3,
+                1.0,
+            ),
+            Bound::new(
+                "touchdown_force_fraction",
+                self.touchdown_force_fraction,
+                1e-3,
+                1.0,
+            ),
+            Bound::new("touchdown_debounce_ticks", ticks, 1.0, 1000.0),
+            Bound::new(
                 "support_force_min_fraction",
                 self.support_force_min_fraction,
+                1e-3,
+                1.0,
             ),
-        ];
-        let fail = |key, value, requirement| ConfigError::Value {
+            Bound::new("unloaded_max_s", self.unloaded_max_s, 0.002, 1.0),
+            Bound::new("phase_timeout_s", self.phase_timeout_s, 0.01, 60.0),
+            Bound::new("max_step_m", self.max_step_m, 0.01, 2.0),
+            Bound::new("command_lead_max_rad", self.command_lead_max_rad, 1e-4, 1.0),
+            Bound::new(
+                "tipping_detection_rad",
+                self.tipping_detection_rad,
+                0.01,
+                1.5,
+            ),
+            Bound::new(
+                "joint_limit_tolerance_rad",
+                self.joint_limit_tolerance_rad,
+                1e-4,
+                0.5,
+            ),
+            Bound::new("workspace_radius_m", self.workspace_radius_m, 0.1, 1000.0),
+            Bound::new("workspace_depth_m", self.workspace_depth_m, 0.01, 10.0),
+            Bound::new("workspace_height_m", self.workspace_height_m, 0.01, 10.0),
+            Bound::new("max_target_step_m", self.max_target_step_m, 0.01, 10.0),
+            Bound::new("max_phase_s", self.max_phase_s, 0.1, 120.0),
+        ]
+    }
+}
+
+/// Fails with the first value of `bounds` outside its range, naming the file, the section and
+/// the key: the check every table of a robot config section ends in.
+pub(crate) fn check(
+    bounds: &[Bound],
+    origin: &str,
+    section: &'static str,
+) -> Result<(), ConfigError> {
+    match first_outside(bounds) {
+        Some(violation) => Err(ConfigError::Value {
             origin: origin.to_owned(),
-            section: SECTION,
-            key,
-            value,
-            requirement,
-        };
-        for (key, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(fail(key, value, "must be finite and > 0"));
-            }
-        }
-        for (key, value) in non_negative {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(fail(key, value, "must be finite and >= 0"));
-            }
-        }
-        for (key, value) in fractions {
-            if !(value > 0.0 && value <= 1.0) {
-                return Err(fail(key, value, "must be in (0, 1]"));
-            }
-        }
-        if self.touchdown_debounce_ticks == 0 {
-            return Err(fail("touchdown_debounce_ticks", 0.0, "must be >= 1"));
-        }
-        Ok(())
+            section,
+            key: violation.key,
+            value: violation.value,
+            requirement: violation.range.requirement(),
+        }),
+        None => Ok(()),
     }
 }
 

@@ -38,7 +38,8 @@ use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::process::{exit_code, install_termination_handler, termination_requested};
 use shm_types::{
-    ClockMode, DaemonLoopPorts, DaemonServicePorts, DaemonStatus, RuntimeConfig, ServiceNames,
+    ClockMode, DaemonLoopPorts, DaemonServicePorts, DaemonStatus, RuntimeConfig, RuntimeOverrides,
+    ServiceNames,
 };
 
 use crate::controller::{Controller, ControllerConfig, GaitConfig, SolverKind};
@@ -82,6 +83,19 @@ pub struct DaemonArgs {
     /// (`client::process::kinematic_sim_settings`).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub overrides: Vec<String>,
+}
+
+impl DaemonArgs {
+    /// The flags that replace `[runtime]` keys.
+    pub fn runtime_overrides(&self) -> RuntimeOverrides {
+        RuntimeOverrides {
+            rate_hz: self.rate_hz,
+            service_prefix: self.service_prefix.clone(),
+            fifo_priority: self.fifo_priority,
+            cpu: self.cpu,
+            spin_us: self.spin_us,
+        }
+    }
 }
 
 /// A failure with the exit code it maps to.
@@ -134,29 +148,13 @@ fn load(args: &DaemonArgs) -> Result<Setup, Failure> {
         file.set(assignment)
             .map_err(|e| fail(exit_code::USAGE)(anyhow::Error::from(e).context("--set")))?;
     }
-    let mut runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())
+    let runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())
         .map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
-    if let Some(rate) = args.rate_hz {
-        if !(rate.is_finite() && rate > 0.0) {
-            return Err(fail(exit_code::USAGE)(anyhow::anyhow!(
-                "--rate-hz {rate} must be positive"
-            )));
-        }
-        runtime.rate_hz = rate;
-    }
-    if let Some(prefix) = &args.service_prefix {
-        runtime.service_prefix.clone_from(prefix);
-    }
-    if args.fifo_priority.is_some() {
-        runtime.fifo_priority = args.fifo_priority;
-    }
-    if args.cpu.is_some() {
-        runtime.cpu = args.cpu;
-    }
+    let mut runtime = args
+        .runtime_overrides()
+        .apply(runtime)
+        .map_err(|e| fail(exit_code::USAGE)(e.into()))?;
     runtime.lock_memory &= !args.no_lock_memory;
-    if let Some(spin_us) = args.spin_us {
-        runtime.spin_us = spin_us;
-    }
     let robot = Robot::from_config(&file, args.urdf.as_deref())
         .map_err(|e| fail(exit_code::CONFIG)(e.into()))?;
     let controller_config =

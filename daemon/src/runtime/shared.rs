@@ -22,7 +22,8 @@ pub struct Submission {
 pub enum StartOutcome {
     /// Executing it.
     Started,
-    /// The controller refused to start it (busy, in fault, no valid measurement, not upright).
+    /// The controller refused to start it (busy, in fault, no valid measurement, not upright,
+    /// not on both feet for a dynamic walk).
     Refused(StartRefusal),
     /// No fresh samples from the adapter: nothing could execute it.
     AdapterStale,
@@ -31,36 +32,36 @@ pub enum StartOutcome {
 }
 
 impl StartOutcome {
-    const REFUSALS: [StartRefusal; 4] = [
-        StartRefusal::Busy,
-        StartRefusal::Faulted,
-        StartRefusal::NoMeasurement,
-        StartRefusal::NotUpright,
-    ];
-
+    /// The outcome's code in the result word: every outcome has its own, so a refusal added to
+    /// [`StartRefusal`] does not compile until it has one here and in [`StartOutcome::from_code`].
     fn code(self) -> u8 {
         match self {
             Self::Started => 1,
             Self::AdapterStale => 2,
             Self::SecondAdapter => 3,
-            Self::Refused(refusal) => {
-                10 + Self::REFUSALS
-                    .iter()
-                    .position(|r| *r == refusal)
-                    .unwrap_or(0) as u8
-            }
+            Self::Refused(StartRefusal::Busy) => 10,
+            Self::Refused(StartRefusal::Faulted) => 11,
+            Self::Refused(StartRefusal::NoMeasurement) => 12,
+            Self::Refused(StartRefusal::NotUpright) => 13,
+            Self::Refused(StartRefusal::NotOnBothFeet) => 14,
+            Self::Refused(StartRefusal::Stopping) => 15,
         }
     }
 
+    /// The outcome of a code written by [`StartOutcome::code`].
     fn from_code(code: u8) -> Option<Self> {
-        match code {
-            1 => Some(Self::Started),
-            2 => Some(Self::AdapterStale),
-            3 => Some(Self::SecondAdapter),
-            _ => Self::REFUSALS
-                .get(usize::from(code.checked_sub(10)?))
-                .map(|r| Self::Refused(*r)),
-        }
+        Some(match code {
+            1 => Self::Started,
+            2 => Self::AdapterStale,
+            3 => Self::SecondAdapter,
+            10 => Self::Refused(StartRefusal::Busy),
+            11 => Self::Refused(StartRefusal::Faulted),
+            12 => Self::Refused(StartRefusal::NoMeasurement),
+            13 => Self::Refused(StartRefusal::NotUpright),
+            14 => Self::Refused(StartRefusal::NotOnBothFeet),
+            15 => Self::Refused(StartRefusal::Stopping),
+            _ => return None,
+        })
     }
 }
 
@@ -71,6 +72,27 @@ pub enum ControlOutcome {
     Done,
     /// The fault could not be acknowledged yet.
     NotAcknowledged(ResetRefusal),
+}
+
+impl ControlOutcome {
+    /// The outcome's code in the outcome byte: every outcome has its own.
+    fn code(self) -> u8 {
+        match self {
+            Self::Done => 0,
+            Self::NotAcknowledged(ResetRefusal::NotUpright) => 1,
+            Self::NotAcknowledged(ResetRefusal::Stopping) => 2,
+        }
+    }
+
+    /// The outcome of a code written by [`ControlOutcome::code`] (the control thread writes
+    /// no other).
+    fn from_code(code: u8) -> Self {
+        match code {
+            1 => Self::NotAcknowledged(ResetRefusal::NotUpright),
+            2 => Self::NotAcknowledged(ResetRefusal::Stopping),
+            _ => Self::Done,
+        }
+    }
 }
 
 /// The state both threads see.
@@ -85,8 +107,8 @@ pub struct Shared {
     control: AtomicU8,
     /// Control → service thread: count of control commands carried out.
     controls_done: AtomicU64,
-    /// Control → service thread: whether the last one acknowledged its fault (0) or not (1).
-    control_refused: AtomicU8,
+    /// Control → service thread: how the last one went ([`ControlOutcome::code`]).
+    control_outcome: AtomicU8,
     /// Main → control thread: shut down.
     pub stop: AtomicBool,
     /// Control → service thread: when the control loop last went round (CLOCK_MONOTONIC ns),
@@ -103,7 +125,7 @@ impl Shared {
             start_result: AtomicU64::new(0),
             control: AtomicU8::new(0),
             controls_done: AtomicU64::new(0),
-            control_refused: AtomicU8::new(0),
+            control_outcome: AtomicU8::new(0),
             stop: AtomicBool::new(false),
             heartbeat_ns: AtomicU64::new(shm_types::monotonic_ns()),
         }
@@ -143,12 +165,8 @@ impl Shared {
     /// Service thread: the outcome of the last control command once `target` (from
     /// [`Shared::request_control`]) of them were carried out.
     pub fn control_outcome(&self, target: u64) -> Option<ControlOutcome> {
-        (self.controls_done.load(Ordering::Acquire) >= target).then(|| {
-            match self.control_refused.load(Ordering::Acquire) {
-                0 => ControlOutcome::Done,
-                _ => ControlOutcome::NotAcknowledged(ResetRefusal::NotUpright),
-            }
-        })
+        (self.controls_done.load(Ordering::Acquire) >= target)
+            .then(|| ControlOutcome::from_code(self.control_outcome.load(Ordering::Acquire)))
     }
 
     /// Control thread: takes the pending control command, if any.
@@ -167,8 +185,8 @@ impl Shared {
 
     /// Control thread: marks a control command as carried out, with its outcome.
     pub fn control_done(&self, outcome: ControlOutcome) {
-        let refused = u8::from(outcome != ControlOutcome::Done);
-        self.control_refused.store(refused, Ordering::Release);
+        self.control_outcome
+            .store(outcome.code(), Ordering::Release);
         self.controls_done.fetch_add(1, Ordering::AcqRel);
     }
 }
@@ -176,5 +194,54 @@ impl Shared {
 impl Default for Shared {
     fn default() -> Self {
         Self::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_start_outcome_round_trips_through_its_code() {
+        let refusals = [
+            StartRefusal::Busy,
+            StartRefusal::Faulted,
+            StartRefusal::NoMeasurement,
+            StartRefusal::NotUpright,
+            StartRefusal::NotOnBothFeet,
+            StartRefusal::Stopping,
+        ];
+        let outcomes = [
+            StartOutcome::Started,
+            StartOutcome::AdapterStale,
+            StartOutcome::SecondAdapter,
+        ]
+        .into_iter()
+        .chain(refusals.map(StartOutcome::Refused));
+        let shared = Shared::new();
+        for (ticket, outcome) in (1..).zip(outcomes) {
+            shared.report_start(ticket, outcome);
+            assert_eq!(shared.start_outcome(ticket), Some(outcome));
+        }
+        for code in 0..=u8::MAX {
+            if let Some(outcome) = StartOutcome::from_code(code) {
+                assert_eq!(outcome.code(), code);
+            }
+        }
+    }
+
+    #[test]
+    fn every_control_outcome_round_trips_through_its_code() {
+        let shared = Shared::new();
+        for outcome in [
+            ControlOutcome::Done,
+            ControlOutcome::NotAcknowledged(ResetRefusal::NotUpright),
+            ControlOutcome::NotAcknowledged(ResetRefusal::Stopping),
+        ] {
+            let target = shared.request_control(ControlCommand::Hold);
+            assert_eq!(shared.take_control(), Some(ControlCommand::Hold));
+            shared.control_done(outcome);
+            assert_eq!(shared.control_outcome(target), Some(outcome));
+        }
     }
 }

@@ -27,12 +27,14 @@ use std::time::Duration;
 use clap::Parser;
 use kinematic_sim::{KinematicSim, SimOptions, Simulator};
 use kinematics::ConfigFile;
+use kinematics::bounds::Range;
 use kinematics::robot::Robot;
 use shm_types::process::{
     InjectedFault, Physics, exit_code, install_termination_handler, termination_requested,
 };
 use shm_types::{
-    AdapterPorts, ClockMode, RuntimeConfig, ServiceNames, TruthPublisher, current_thread_is_fifo,
+    AdapterPorts, ClockMode, RuntimeConfig, RuntimeOverrides, ServiceNames, TruthPublisher,
+    current_thread_is_fifo,
 };
 use sim_adapter::inject::{FaultInjector, FaultPlan};
 use sim_adapter::{AdapterOptions, PublishTruth, SimulatedRobot, run_adapter};
@@ -69,11 +71,17 @@ struct Args {
     /// sim-adapter/render).
     #[arg(long, value_name = "DIR")]
     snapshots: Option<PathBuf>,
-    /// Simulated time between two pictures (s).
-    #[arg(long, default_value_t = 0.5)]
+    /// Simulated time between two pictures (s, 0.01-60).
+    #[arg(long, default_value_t = 0.5, value_parser = Range::new(0.01, 60.0).parser())]
     snapshot_period: f64,
-    /// The point the side camera looks at: x,y,z (m, world).
-    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.0, 0.8])]
+    /// The point the side camera looks at: x,y,z (m, world; each within ±100).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_values_t = [0.0, 0.0, 0.8],
+        allow_hyphen_values = true,
+        value_parser = Range::new(-100.0, 100.0).parser()
+    )]
     snapshot_lookat: Vec<f64>,
     /// Fault injection for evaluation: what goes wrong (a NaN or out-of-limit joint in one
     /// sample, one sample without foot forces, a hold or abort request, a withheld touchdown).
@@ -129,20 +137,16 @@ fn main() -> ExitCode {
 fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
     let config_error = |e: anyhow::Error| (exit_code::CONFIG, e);
     let file = ConfigFile::load(&args.config).map_err(|e| config_error(e.into()))?;
-    let mut runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())
+    let runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())
         .map_err(|e| config_error(e.into()))?;
-    if let Some(rate) = args.rate_hz {
-        runtime.rate_hz = rate;
-    }
-    if let Some(prefix) = &args.service_prefix {
-        runtime.service_prefix.clone_from(prefix);
-    }
-    if !(runtime.rate_hz.is_finite() && runtime.rate_hz > 0.0) {
-        return Err(config_error(anyhow::anyhow!(
-            "--rate-hz {} must be positive",
-            runtime.rate_hz
-        )));
-    }
+    let overrides = RuntimeOverrides {
+        rate_hz: args.rate_hz,
+        service_prefix: args.service_prefix.clone(),
+        ..RuntimeOverrides::default()
+    };
+    let runtime = overrides
+        .apply(runtime)
+        .map_err(|e| (exit_code::USAGE, e.into()))?;
     let robot =
         Robot::from_config(&file, args.urdf.as_deref()).map_err(|e| config_error(e.into()))?;
     let robot = Arc::new(robot);

@@ -33,14 +33,14 @@ pub enum MujocoError {
     #[error("rendering: {0}")]
     Render(String),
     /// An option is out of range.
-    #[error("MuJoCo option `{name}` = {value} must be {requirement}")]
+    #[error("MuJoCo option `{name}` = {}: {requirement}", kinematics::bounds::Number(*value))]
     BadOption {
         /// Field of [`super::MujocoOptions`].
         name: &'static str,
         /// The value given.
         value: f64,
-        /// What it must be.
-        requirement: &'static str,
+        /// What it must satisfy.
+        requirement: String,
     },
     /// A command (or the initial joint vector) has the wrong length or a non-finite entry.
     #[error("{0}")]

@@ -1,5 +1,9 @@
 //! Tunable parameters of the MuJoCo model; the defaults suit the vendored humanoids.
 
+use kinematics::bounds::{Bound, first_outside};
+
+use super::MujocoError;
+
 /// How the physics model is built and stepped.
 ///
 /// Joint servos are position + velocity actuators: `τ = kp·(q_des − q) + kv·(q̇_des − q̇)`, the way
@@ -70,6 +74,129 @@ impl Default for MujocoOptions {
             mass_scale: 1.0,
             pelvis_com_offset: [0.0; 3],
             visual_geoms: true,
+        }
+    }
+}
+
+impl MujocoOptions {
+    /// Checks every option against its documented range (docs/mujoco.md, "Options") and the
+    /// contact time constant against the time step; the error names the option.
+    pub fn check(&self) -> Result<(), MujocoError> {
+        if let Some(violation) = first_outside(&self.bounds()) {
+            return Err(MujocoError::BadOption {
+                name: violation.key,
+                value: violation.value,
+                requirement: violation.range.requirement(),
+            });
+        }
+        if self.contact_time_constant < 2.0 * self.timestep {
+            return Err(MujocoError::BadOption {
+                name: "contact_time_constant",
+                value: self.contact_time_constant,
+                requirement: "must be at least twice the timestep".to_owned(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Every numeric option, its value and its range, one line an option.
+    pub fn bounds(&self) -> Vec<Bound> {
+        let offset = self.pelvis_com_offset;
+        vec![
+            Bound::new("timestep", self.timestep, 1e-5, 0.01),
+            Bound::new("servo_stiffness", self.servo_stiffness, 1.0, 1e7),
+            Bound::new("servo_damping", self.servo_damping, 0.0, 1e5),
+            Bound::new("armature", self.armature, 0.0, 100.0),
+            Bound::new("joint_damping", self.joint_damping, 0.0, 1e4),
+            Bound::new("friction", self.friction, 0.0, 10.0),
+            Bound::new("sole_thickness", self.sole_thickness, 1e-3, 0.2),
+            Bound::new(
+                "contact_time_constant",
+                self.contact_time_constant,
+                2e-5,
+                1.0,
+            ),
+            Bound::new("fall_height_fraction", self.fall_height_fraction, 0.0, 1.0),
+            Bound::new("fall_tilt", self.fall_tilt, 0.01, std::f64::consts::PI),
+            Bound::new("mass_scale", self.mass_scale, 0.1, 10.0),
+            Bound::new("pelvis_com_offset", offset[0], -0.5, 0.5),
+            Bound::new("pelvis_com_offset", offset[1], -0.5, 0.5),
+            Bound::new("pelvis_com_offset", offset[2], -0.5, 0.5),
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The option that failed and the requirement it broke, or `None` when all pass.
+    fn rejection(options: MujocoOptions) -> Option<(&'static str, String)> {
+        match options.check() {
+            Ok(()) => None,
+            Err(MujocoError::BadOption {
+                name, requirement, ..
+            }) => Some((name, requirement)),
+            Err(other) => panic!("unexpected error {other}"),
+        }
+    }
+
+    #[test]
+    fn bad_options_are_rejected_by_name() {
+        let defaults = MujocoOptions::default();
+        assert_eq!(rejection(defaults), None);
+        let zero_damping = MujocoOptions {
+            servo_damping: 0.0,
+            ..defaults
+        };
+        assert_eq!(rejection(zero_damping), None);
+        for (options, name, requirement) in [
+            (
+                MujocoOptions {
+                    timestep: 0.0,
+                    ..defaults
+                },
+                "timestep",
+                "must be in [1e-5, 0.01]",
+            ),
+            (
+                MujocoOptions {
+                    friction: f64::NAN,
+                    ..defaults
+                },
+                "friction",
+                "must be in [0, 10]",
+            ),
+            (
+                MujocoOptions {
+                    mass_scale: 1e9,
+                    ..defaults
+                },
+                "mass_scale",
+                "must be in [0.1, 10]",
+            ),
+            (
+                MujocoOptions {
+                    pelvis_com_offset: [0.0, f64::INFINITY, 0.0],
+                    ..defaults
+                },
+                "pelvis_com_offset",
+                "must be in [-0.5, 0.5]",
+            ),
+            (
+                MujocoOptions {
+                    contact_time_constant: defaults.timestep,
+                    ..defaults
+                },
+                "contact_time_constant",
+                "must be at least twice the timestep",
+            ),
+        ] {
+            assert_eq!(
+                rejection(options),
+                Some((name, requirement.to_owned())),
+                "{name}"
+            );
         }
     }
 }

@@ -74,7 +74,7 @@ impl MujocoSim {
         options: MujocoOptions,
     ) -> Result<Self, MujocoError> {
         check_library_version()?;
-        check_options(&options)?;
+        options.check()?;
         check_joint_vector(&robot.model, "initial.joints", initial.joints.as_slice())?;
         let base = &initial.base;
         if !(base
@@ -357,56 +357,6 @@ fn check_library_version() -> Result<(), MujocoError> {
     Ok(())
 }
 
-fn check_options(options: &MujocoOptions) -> Result<(), MujocoError> {
-    let o = options;
-    let positive = [
-        ("timestep", o.timestep),
-        ("mass_scale", o.mass_scale),
-        ("servo_stiffness", o.servo_stiffness),
-        ("sole_thickness", o.sole_thickness),
-        ("contact_time_constant", o.contact_time_constant),
-        ("fall_tilt", o.fall_tilt),
-    ];
-    let non_negative = [
-        ("servo_damping", o.servo_damping),
-        ("armature", o.armature),
-        ("joint_damping", o.joint_damping),
-        ("friction", o.friction),
-        ("fall_height_fraction", o.fall_height_fraction),
-    ];
-    let offsets = o.pelvis_com_offset.map(|v| ("pelvis_com_offset", v));
-    require_all(&offsets, |_| true, "finite")?;
-    require_all(&positive, |v| v > 0.0, "positive and finite")?;
-    require_all(&non_negative, |v| v >= 0.0, "non-negative and finite")?;
-    if o.contact_time_constant < 2.0 * o.timestep {
-        return Err(MujocoError::BadOption {
-            name: "contact_time_constant",
-            value: o.contact_time_constant,
-            requirement: "at least twice the timestep",
-        });
-    }
-    Ok(())
-}
-
-/// Fails on the first option that is not finite or not `allowed`, naming it and `requirement`.
-fn require_all(
-    options: &[(&'static str, f64)],
-    allowed: impl Fn(f64) -> bool,
-    requirement: &'static str,
-) -> Result<(), MujocoError> {
-    match options
-        .iter()
-        .find(|&&(_, value)| !(value.is_finite() && allowed(value)))
-    {
-        Some(&(name, value)) => Err(MujocoError::BadOption {
-            name,
-            value,
-            requirement,
-        }),
-        None => Ok(()),
-    }
-}
-
 /// The servos track `q_des` (clamped into the joint limits, each clamp counted as a violation)
 /// and `qd_des`; a step runs the physics steps that fit in `dt` and carries the remainder into
 /// the next call (a call with no step due leaves the measurement as it was). The measurement is
@@ -496,64 +446,5 @@ impl Simulator for MujocoSim {
 
     fn time(&self) -> f64 {
         self.data.time()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The option that failed and the requirement it broke, or `None` when all pass.
-    fn rejection(options: MujocoOptions) -> Option<(&'static str, &'static str)> {
-        match check_options(&options) {
-            Ok(()) => None,
-            Err(MujocoError::BadOption {
-                name, requirement, ..
-            }) => Some((name, requirement)),
-            Err(other) => panic!("unexpected error {other}"),
-        }
-    }
-
-    #[test]
-    fn bad_options_are_rejected_by_name() {
-        let defaults = MujocoOptions::default();
-        assert_eq!(rejection(defaults), None);
-        let zero_damping = MujocoOptions {
-            servo_damping: 0.0,
-            ..defaults
-        };
-        assert_eq!(rejection(zero_damping), None);
-        let zero_timestep = MujocoOptions {
-            timestep: 0.0,
-            ..defaults
-        };
-        assert_eq!(
-            rejection(zero_timestep),
-            Some(("timestep", "positive and finite"))
-        );
-        let nan_friction = MujocoOptions {
-            friction: f64::NAN,
-            ..defaults
-        };
-        assert_eq!(
-            rejection(nan_friction),
-            Some(("friction", "non-negative and finite"))
-        );
-        let negative_armature = MujocoOptions {
-            armature: -1.0,
-            ..defaults
-        };
-        assert_eq!(
-            rejection(negative_armature),
-            Some(("armature", "non-negative and finite"))
-        );
-        let stiff_contact = MujocoOptions {
-            contact_time_constant: defaults.timestep,
-            ..defaults
-        };
-        assert_eq!(
-            rejection(stiff_contact),
-            Some(("contact_time_constant", "at least twice the timestep"))
-        );
     }
 }

@@ -57,9 +57,13 @@ pub struct SourceArgs {
     /// Trained n-gram model (see `walkctl learn`), e.g. data/models/default-ngram.json.
     #[arg(long, value_name = "MODEL.json")]
     pub model: Option<PathBuf>,
-    /// With a model: the most probable sequence (beam search of this width) instead of a
-    /// sequence sampled with the seed.
-    #[arg(long, value_name = "WIDTH")]
+    /// With a model: the most probable sequence (beam search of this width, 1-1000) instead of
+    /// a sequence sampled with the seed.
+    #[arg(
+        long,
+        value_name = "WIDTH",
+        value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000)
+    )]
     pub beam: Option<usize>,
 }
 

@@ -9,8 +9,10 @@ use serde::Deserialize;
 use stance::Gait;
 
 use kinematics::ConfigFile;
+use kinematics::bounds::Bound;
+use kinematics::config_file::toml_message;
 
-use crate::controller::config::ConfigError;
+use crate::controller::config::{ConfigError, check};
 
 /// What a robot config says about gaits. Without a `[gait]` section a robot walks statically
 /// only.
@@ -241,6 +243,15 @@ impl GaitConfig {
             parsed.validate(origin)?;
             config.dynamic = Some(parsed);
         }
+        if config.default == Gait::Dynamic && config.dynamic.is_none() {
+            return Err(ConfigError::Section {
+                origin: origin.to_owned(),
+                section: GAIT,
+                message: "default = \"dynamic\" needs a [gait.dynamic] section (the dynamic \
+                          gait's tuning); add one, or keep default = \"static\""
+                    .to_owned(),
+            });
+        }
         Ok(config)
     }
 }
@@ -275,96 +286,103 @@ fn deserialize<T: serde::de::DeserializeOwned>(
         .map_err(|e: toml::de::Error| ConfigError::Section {
             origin: origin.to_owned(),
             section,
-            message: e.message().to_owned(),
+            message: toml_message(&e),
         })
 }
 
 impl DynamicGaitConfig {
-    /// Checks every value is finite and in range; `origin` names the file in the error.
+    /// Checks every value against its documented range (docs/controller.md, "Dynamic gait");
+    /// `origin` names the file in the error.
     pub fn validate(&self, origin: &str) -> Result<(), ConfigError> {
-        let s = &self.stabilizer;
-        let positive = [
-            (DYNAMIC, "single_support_s", self.single_support_s),
-            (DYNAMIC, "double_support_s", self.double_support_s),
-            (
-                DYNAMIC,
-                "initial_double_support_s",
-                self.initial_double_support_s,
-            ),
-            (
-                DYNAMIC,
-                "final_double_support_s",
-                self.final_double_support_s,
-            ),
-            (DYNAMIC, "stop_double_support_s", self.stop_double_support_s),
-            (DYNAMIC, "hand_transition_s", self.hand_transition_s),
-            (DYNAMIC, "com_height_m", self.com_height_m.unwrap_or(1.0)),
-            (DYNAMIC, "hand_weight", self.hand_weight.unwrap_or(1.0)),
-            (
-                DYNAMIC,
-                "torso_posture_weight",
-                self.torso_posture_weight.unwrap_or(1.0),
-            ),
-            (DYNAMIC, "late_descent_speed", self.late_descent_speed),
-            (STABILIZER, "dcm_gain", s.dcm_gain),
-            (STABILIZER, "velocity_filter_s", s.velocity_filter_s),
-            (
-                STABILIZER,
-                "zmp_offset_time_constant_s",
-                s.zmp_offset_time_constant_s,
-            ),
-            (STABILIZER, "tilt_rate_filter_s", s.tilt_rate_filter_s),
-            (STABILIZER, "foot_damping_leak_s", s.foot_damping_leak_s),
-        ];
-        let non_negative = [
-            (DYNAMIC, "landing_depth_m", self.landing_depth_m),
-            (DYNAMIC, "early_touchdown_s", self.early_touchdown_s),
-            (DYNAMIC, "late_touchdown_max_s", self.late_touchdown_max_s),
-            (DYNAMIC, "late_lift_off_max_s", self.late_lift_off_max_s),
-            (DYNAMIC, "zmp_inward_offset_m", self.zmp_inward_offset_m),
-            (STABILIZER, "zmp_margin_m", s.zmp_margin_m),
-            (STABILIZER, "zmp_offset_max_m", s.zmp_offset_max_m),
-            (STABILIZER, "foot_damping_gain", s.foot_damping_gain),
-            (
-                STABILIZER,
-                "foot_damping_max_speed",
-                s.foot_damping_max_speed,
-            ),
-            (STABILIZER, "force_difference_gain", s.force_difference_gain),
-            (
-                STABILIZER,
-                "force_difference_max_speed",
-                s.force_difference_max_speed,
-            ),
-            (STABILIZER, "tilt_damping_s", s.tilt_damping_s),
-            (STABILIZER, "tilt_damping_max_rad", s.tilt_damping_max_rad),
-        ];
-        let fail = |section, key, value, requirement| ConfigError::Value {
-            origin: origin.to_owned(),
-            section,
-            key,
-            value,
-            requirement,
-        };
-        for (section, key, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(fail(section, key, value, "must be finite and > 0"));
-            }
-        }
-        for (section, key, value) in non_negative {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(fail(section, key, value, "must be finite and >= 0"));
-            }
-        }
+        check(&self.bounds(), origin, DYNAMIC)?;
+        check(&self.stabilizer.bounds(), origin, STABILIZER)?;
         if self.early_touchdown_s >= self.single_support_s {
-            return Err(fail(
-                DYNAMIC,
-                "early_touchdown_s",
-                self.early_touchdown_s,
-                "must be shorter than single_support_s",
-            ));
+            return Err(ConfigError::Value {
+                origin: origin.to_owned(),
+                section: DYNAMIC,
+                key: "early_touchdown_s",
+                value: self.early_touchdown_s,
+                requirement: "must be shorter than single_support_s".to_owned(),
+            });
         }
         Ok(())
+    }
+
+    /// The `[gait.dynamic]` table: every numeric key, its value and its range, one line a key.
+    pub fn bounds(&self) -> Vec<Bound> {
+        vec![
+            Bound::new("single_support_s", self.single_support_s, 0.1, 5.0),
+            Bound::new("double_support_s", self.double_support_s, 0.01, 5.0),
+            Bound::new(
+                "initial_double_support_s",
+                self.initial_double_support_s,
+                0.1,
+                10.0,
+            ),
+            Bound::new(
+                "final_double_support_s",
+                self.final_double_support_s,
+                0.1,
+                10.0,
+            ),
+            Bound::new(
+                "stop_double_support_s",
+                self.stop_double_support_s,
+                0.1,
+                10.0,
+            ),
+            Bound::new("hand_transition_s", self.hand_transition_s, 0.05, 10.0),
+            Bound::optional("com_height_m", self.com_height_m, 0.1, 3.0),
+            Bound::new("landing_depth_m", self.landing_depth_m, 0.0, 0.05),
+            Bound::new("early_touchdown_s", self.early_touchdown_s, 0.0, 1.0),
+            Bound::new("late_touchdown_max_s", self.late_touchdown_max_s, 0.0, 2.0),
+            Bound::new("late_descent_speed", self.late_descent_speed, 1e-3, 1.0),
+            Bound::new("late_lift_off_max_s", self.late_lift_off_max_s, 0.0, 2.0),
+            Bound::optional("hand_weight", self.hand_weight, 1e-6, 1e6),
+            Bound::new("zmp_inward_offset_m", self.zmp_inward_offset_m, 0.0, 0.2),
+            Bound::optional("torso_posture_weight", self.torso_posture_weight, 1e-6, 1e6),
+        ]
+    }
+}
+
+impl StabilizerConfig {
+    /// The `[gait.dynamic.stabilizer]` table: every numeric key, its value and its range.
+    pub fn bounds(&self) -> Vec<Bound> {
+        vec![
+            Bound::new("zmp_margin_m", self.zmp_margin_m, 0.0, 0.1),
+            Bound::new("dcm_gain", self.dcm_gain, 0.1, 20.0),
+            Bound::new("velocity_filter_s", self.velocity_filter_s, 1e-4, 1.0),
+            Bound::new(
+                "zmp_offset_time_constant_s",
+                self.zmp_offset_time_constant_s,
+                0.01,
+                100.0,
+            ),
+            Bound::new("zmp_offset_max_m", self.zmp_offset_max_m, 0.0, 0.2),
+            Bound::new("foot_damping_gain", self.foot_damping_gain, 0.0, 0.1),
+            Bound::new(
+                "foot_damping_max_speed",
+                self.foot_damping_max_speed,
+                0.0,
+                10.0,
+            ),
+            Bound::new("foot_damping_leak_s", self.foot_damping_leak_s, 0.01, 100.0),
+            Bound::new(
+                "force_difference_gain",
+                self.force_difference_gain,
+                0.0,
+                0.01,
+            ),
+            Bound::new(
+                "force_difference_max_speed",
+                self.force_difference_max_speed,
+                0.0,
+                1.0,
+            ),
+            Bound::new("tilt_damping_s", self.tilt_damping_s, 0.0, 1.0),
+            Bound::new("tilt_rate_filter_s", self.tilt_rate_filter_s, 1e-4, 1.0),
+            Bound::new("tilt_damping_max_rad", self.tilt_damping_max_rad, 0.0, 0.5),
+        ]
     }
 }
 
@@ -382,6 +400,17 @@ mod tests {
         assert_eq!(config.default, Gait::Static);
         let reason = config.dynamic().unwrap_err();
         assert!(reason.contains("[gait.dynamic]"), "{reason}");
+    }
+
+    #[test]
+    fn a_dynamic_default_without_its_section_is_refused_naming_the_file_and_the_section() {
+        let error = parse("[gait]\ndefault = \"dynamic\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("robot.toml") && error.contains("[gait.dynamic]"),
+            "{error}"
+        );
     }
 
     #[test]
@@ -424,6 +453,26 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("fast"), "{error}");
+    }
+
+    #[test]
+    fn durations_and_gains_have_upper_bounds() {
+        for (table, key) in [
+            ("gait.dynamic", "single_support_s"),
+            ("gait.dynamic", "double_support_s"),
+            ("gait.dynamic", "initial_double_support_s"),
+            ("gait.dynamic", "final_double_support_s"),
+            ("gait.dynamic", "stop_double_support_s"),
+            ("gait.dynamic", "late_touchdown_max_s"),
+            ("gait.dynamic", "late_lift_off_max_s"),
+            ("gait.dynamic.stabilizer", "dcm_gain"),
+            ("gait.dynamic.stabilizer", "zmp_offset_time_constant_s"),
+        ] {
+            let error = parse(&format!("[{table}]\n{key} = 1e9\n"))
+                .expect_err(key)
+                .to_string();
+            assert!(error.contains(&format!("[{table}] {key}")), "{error}");
+        }
     }
 
     #[test]
