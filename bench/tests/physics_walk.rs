@@ -296,9 +296,10 @@ mod walks {
 
 /// A fault in single support must not become a fall (docs/safety.md, "Controlled stop"): a
 /// dynamic walk under MuJoCo, faulted half way through its fourth single support by a NaN joint
-/// angle in one measurement or by a hold request, ends standing on both feet, not fallen, holding
-/// (in fault after the NaN), within 2 s of the fault, and stays standing for a second more. JVRC-1
-/// and ARMAR-4. Holding the last command in single support instead, the robot fell: 8 of 8 faults
+/// angle in one measurement, by a hold request, or by the samples stopping for 0.1 s (the
+/// watchdog's hold; the commands still reach the robot), ends standing on both feet, not fallen,
+/// holding (in fault after the NaN), within 2 s of the fault, and stays standing for a second
+/// more. JVRC-1 and ARMAR-4. Holding the last command in single support instead, the robot fell: 8 of 8 faults
 /// in the hostile trials of issue 20.
 #[cfg(feature = "mujoco")]
 mod stops {
@@ -322,7 +323,11 @@ mod stops {
     enum Fault {
         NanJointAngle,
         Hold,
+        SamplesLost,
     }
+
+    /// How long the samples stop in [`Fault::SamplesLost`] (s).
+    const SAMPLES_LOST_S: f64 = 0.1;
 
     /// One tick of `closed`; with `nan`, the measured angle of joint 0 is NaN.
     fn tick(closed: &mut ClosedLoop<MujocoSim>, nan: bool) {
@@ -412,6 +417,18 @@ mod stops {
                 closed.controller.hold();
                 tick(&mut closed, false);
             }
+            Fault::SamplesLost => {
+                closed.controller.hold();
+                for _ in 0..(SAMPLES_LOST_S * RATE_HZ) as usize {
+                    let dt = closed.dt();
+                    let command = &mut closed.command;
+                    assert!(closed.controller.tick_without_measurement(dt, command));
+                    closed
+                        .sim
+                        .step(command.q_des.as_slice(), command.qd_des.as_slice(), dt)
+                        .expect("MuJoCo steps");
+                }
+            }
         }
         let held = |state: ControllerState| {
             matches!(state, ControllerState::Fault | ControllerState::Holding)
@@ -431,7 +448,7 @@ mod stops {
         let status = closed.controller.status();
         let expected = match fault {
             Fault::NanJointAngle => ControllerState::Fault,
-            Fault::Hold => ControllerState::Holding,
+            Fault::Hold | Fault::SamplesLost => ControllerState::Holding,
         };
         assert_eq!(status.state, expected, "{name}: {:?}", status.fault);
         assert!(!closed.sim.has_fallen(), "{name}: fell after the stop");
@@ -449,11 +466,13 @@ mod stops {
     fn jvrc1_stops_on_both_feet_after_a_fault_in_single_support() {
         stop("jvrc1", Fault::NanJointAngle);
         stop("jvrc1", Fault::Hold);
+        stop("jvrc1", Fault::SamplesLost);
     }
 
     #[test]
     fn armar4_stops_on_both_feet_after_a_fault_in_single_support() {
         stop("armar4", Fault::NanJointAngle);
         stop("armar4", Fault::Hold);
+        stop("armar4", Fault::SamplesLost);
     }
 }

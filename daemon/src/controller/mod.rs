@@ -391,6 +391,25 @@ impl Controller {
         self.tick_on_last_state(dt, out)
     }
 
+    /// RT: a control period without a sample (the adapter link is stale). A controlled stop
+    /// under way goes on, on the last valid state with the plan fed forward, so an adapter that
+    /// still receives commands brings the robot to rest; otherwise nothing is commanded. Returns
+    /// whether `out` holds a command.
+    #[must_use]
+    pub fn tick_without_measurement(&mut self, dt: f64, out: &mut Command) -> bool {
+        if !self.stopping() || !(dt.is_finite() && dt > 0.0) {
+            return false;
+        }
+        self.status.ticks += 1;
+        self.tick_on_last_state(dt, out)
+    }
+
+    /// Whether a controlled stop is under way: the controller needs its ticks, with or without
+    /// measurements, until the robot rests.
+    pub fn stopping(&self) -> bool {
+        self.status.state == ControllerState::ControlledStop
+    }
+
     /// RT: the adapter restarted, or its link came back after the watchdog tripped: the robot
     /// may stand anywhere now. The world frame, the base estimate and the hold posture are set
     /// up again from the next valid measurement (no command until then); a walk in progress

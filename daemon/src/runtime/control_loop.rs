@@ -16,7 +16,10 @@
 //!   sample stamped in a later period is answered in that period); `watchdog_periods` stale
 //!   periods in a row trip the watchdog: the controller holds, a hold command goes out and the
 //!   status reports the stale link; the grid re-aligns on the next sample, and also whenever the
-//!   adapter's phase moves by more than a quarter period.
+//!   adapter's phase moves by more than a quarter period. A dynamic walk's hold is a controlled
+//!   stop: instead of the hold command it goes on every period without samples, on the last valid
+//!   state (an adapter that still receives commands brings the robot to rest), and when samples
+//!   come back it goes on from them rather than setting up the world again.
 //!
 //! Lockstep clock: one tick per received sample, no sleeping; the watchdog trips after
 //! `lockstep_timeout` of wall time without a sample.
@@ -256,6 +259,9 @@ impl ControlLoop {
                 monotonic_ns()
             } else {
                 self.stale_period();
+                if self.link == LinkState::Stale && self.controller.stopping() {
+                    self.tick_without_sample()?;
+                }
                 let now = monotonic_ns();
                 if now > end {
                     self.stats.stale_periods = self
@@ -271,7 +277,7 @@ impl ControlLoop {
             } else {
                 end
             };
-            start = if self.link == LinkState::Stale {
+            start = if self.link == LinkState::Stale && !self.controller.stopping() {
                 None
             } else if fresh && self.sample.timestamp_ns.abs_diff(expected) > period / 4 {
                 // The adapter's phase moved (another clock, a restart): follow it.
@@ -379,8 +385,9 @@ impl ControlLoop {
     /// One control step on `self.sample`. Between taking the sample and sending the command
     /// only the controller runs; submissions, control requests and the status come after.
     fn tick(&mut self, tick_start: u64) -> Result<TickTimes, ShmError> {
-        if self.link == LinkState::Stale {
-            // Whatever happened while the link was down, start from what is measured now.
+        if self.link == LinkState::Stale && !self.controller.stopping() {
+            // Whatever happened while the link was down, start from what is measured now. A
+            // controlled stop that ran on without samples goes on from the measurement instead.
             self.controller.relink();
         }
         self.link = LinkState::Fresh;
@@ -462,6 +469,22 @@ impl ControlLoop {
         }
     }
 
+    /// Realtime, the link stale: a controlled stop goes on without samples, so an adapter that
+    /// still receives commands brings the robot to rest (`Controller::tick_without_measurement`).
+    fn tick_without_sample(&mut self) -> Result<(), ShmError> {
+        let dt = self.timing.period_ns as f64 * 1e-9;
+        if self
+            .controller
+            .tick_without_measurement(dt, &mut self.command)
+        {
+            self.send_command()?;
+        }
+        if self.note_state_change() {
+            self.write_status(self.daemon_state());
+        }
+        Ok(())
+    }
+
     /// Realtime: a period ended without a fresh sample.
     fn stale_period(&mut self) {
         self.stats.stale_periods = self.stats.stale_periods.saturating_add(1);
@@ -482,6 +505,11 @@ impl ControlLoop {
             .record("adapter link stale: no fresh sensor sample within the watchdog time");
         if self.controller.status().state == ControllerState::Executing {
             self.controller.hold();
+        }
+        if self.timing.clock == ClockMode::Realtime && self.controller.stopping() {
+            // A dynamic walk's controlled stop goes on without samples, period by period.
+            self.write_status(self.daemon_state());
+            return;
         }
         // Tell the adapter to hold too, in case only its samples are lost.
         self.command.mode = CommandMode::Hold;

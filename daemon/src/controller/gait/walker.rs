@@ -627,9 +627,13 @@ impl DynamicWalker {
         self.targets.balance = Balance::ComHeight(ground + self.plan().com_height);
         self.targets.torso_posture_weight = self.plan().config.torso_posture_weight;
         if self.blind {
-            // No force-torque to comply with: the feet hold their anchors.
+            // No force-torque to comply with: the feet hold their anchors, and the compliance
+            // starts afresh when readings come back (a tilt rate differenced across a gap, or
+            // the rotation applied before it, would otherwise kick the stance foot).
             self.targets.contact_velocity = [[0.0; 6]; 2];
             self.foot_turn = [Vector2::zeros(); 2];
+            self.tilt_rate.reset();
+            self.tilt_damping.reset();
         } else {
             self.comply(command.zmp, sensors, ground, dt);
         }
