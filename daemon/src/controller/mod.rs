@@ -397,7 +397,7 @@ impl Controller {
     /// whether `out` holds a command.
     #[must_use]
     pub fn tick_without_measurement(&mut self, dt: f64, out: &mut Command) -> bool {
-        if !self.stopping() || !(dt.is_finite() && dt > 0.0) {
+        if !(self.stopping() && dt.is_finite() && dt > 0.0) {
             return false;
         }
         self.status.ticks += 1;
