@@ -201,6 +201,12 @@ impl Command {
             mode: CommandMode::Hold,
         }
     }
+
+    /// Whether every angle and velocity is finite: half of what the controller guarantees for
+    /// every command it writes (the other half: inside the joint limits).
+    pub fn is_finite(&self) -> bool {
+        self.q_des.iter().chain(&self.qd_des).all(|v| v.is_finite())
+    }
 }
 
 /// Why a controller could not be built.
