@@ -24,6 +24,15 @@ pub enum TickError<E> {
     Sim(E),
 }
 
+/// What the controller is about to read in a tick, for a test to tamper with first (fault
+/// injection): the joint angles and the wrenches.
+pub struct Readings<'a> {
+    /// Joint angles, model order.
+    pub q: &'a mut [f64],
+    /// Wrenches by `EndEffector`.
+    pub wrenches: &'a mut [[f64; 6]; 4],
+}
+
 /// A controller and the simulated robot it controls.
 pub struct ClosedLoop<S> {
     /// The controller (its status, its last QP).
@@ -32,17 +41,20 @@ pub struct ClosedLoop<S> {
     pub sim: S,
     /// The last command sent.
     pub command: Command,
+    /// The joint angles of a tick, as the controller reads them.
+    q: Vec<f64>,
     dt: f64,
 }
 
 impl<S: Simulator> ClosedLoop<S> {
     /// `controller` driving `sim` at `rate_hz` (the simulator advances by `1 / rate_hz` a tick).
     pub fn new(controller: Controller, sim: S, rate_hz: f64) -> Self {
-        let command = Command::new(controller.robot().model.dof());
+        let dof = controller.robot().model.dof();
         Self {
             controller,
             sim,
-            command,
+            command: Command::new(dof),
+            q: vec![0.0; dof],
             dt: 1.0 / rate_hz,
         }
     }
@@ -57,17 +69,21 @@ impl<S: Simulator> ClosedLoop<S> {
         self.tick_with(|_| {})
     }
 
-    /// One tick with the measured wrenches passed through `tamper` first (fault injection);
-    /// returns the controller's compute time.
+    /// One tick with the readings passed through `tamper` first (fault injection); returns the
+    /// controller's compute time. Allocation-free.
     pub fn tick_with(
         &mut self,
-        tamper: impl FnOnce(&mut [[f64; 6]; 4]),
+        tamper: impl FnOnce(Readings<'_>),
     ) -> Result<Duration, TickError<S::Error>> {
         let m = self.sim.measurement();
         let mut wrenches = m.wrenches;
-        tamper(&mut wrenches);
+        self.q.copy_from_slice(m.q.as_slice());
+        tamper(Readings {
+            q: &mut self.q,
+            wrenches: &mut wrenches,
+        });
         let measurement = Measurement {
-            q: m.q.as_slice(),
+            q: &self.q,
             qd: m.qd.as_slice(),
             wrenches: &wrenches,
             imu_orientation: Some(m.base_orientation),

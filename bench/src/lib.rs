@@ -26,7 +26,7 @@ pub mod physics;
 pub mod sequence;
 pub mod walk;
 
-pub use closed_loop::{ClosedLoop, TickError};
+pub use closed_loop::{ClosedLoop, Readings, TickError};
 pub use walk::{
     Outcome, TickObservation, WalkError, WalkOptions, WalkReport, kinematic_gaits, walk,
 };

@@ -306,8 +306,7 @@ mod stops {
     use std::sync::Arc;
 
     use daemon::controller::{
-        Controller, ControllerConfig, ControllerState, Gait, GaitConfig, Measurement, Phase,
-        SolverKind,
+        Controller, ControllerConfig, ControllerState, Gait, GaitConfig, Phase, SolverKind,
     };
     use kinematic_sim::Simulator;
     use kinematics::robot::{EndEffector, Robot};
@@ -331,30 +330,14 @@ mod stops {
 
     /// One tick of `closed`; with `nan`, the measured angle of joint 0 is NaN.
     fn tick(closed: &mut ClosedLoop<MujocoSim>, nan: bool) {
-        let m = closed.sim.measurement();
-        let mut q = m.q.clone();
-        if nan {
-            q[0] = f64::NAN;
-        }
-        let measurement = Measurement {
-            q: q.as_slice(),
-            qd: m.qd.as_slice(),
-            wrenches: &m.wrenches,
-            imu_orientation: Some(m.base_orientation),
-        };
-        let dt = closed.dt();
-        assert!(
-            closed
-                .controller
-                .tick(&measurement, dt, &mut closed.command),
-            "a command after every tick"
-        );
-        let command = &closed.command;
-        assert!(command.is_finite());
         closed
-            .sim
-            .step(command.q_des.as_slice(), command.qd_des.as_slice(), dt)
-            .expect("MuJoCo steps");
+            .tick_with(|readings| {
+                if nan {
+                    readings.q[0] = f64::NAN;
+                }
+            })
+            .expect("a command after every tick, and MuJoCo steps");
+        assert!(closed.command.is_finite());
     }
 
     /// `robot` walks 2 m dynamically and meets `fault` half way through its fourth single

@@ -240,6 +240,52 @@ fn a_touchdown_force_torque_never_confirms_ends_in_a_controlled_stop_on_both_fee
     );
 }
 
+/// A swing foot that cannot reach its foothold ends the controlled stop with
+/// `stop_could_not_land`, the one way a stop holds on one foot, and says so. Force-torque never
+/// confirms the right foot's touchdown, and its sole reads above the foothold's height: the
+/// measured knee of the swinging leg reads 0.3 rad more bent than it is.
+#[test]
+fn a_stop_that_cannot_land_its_swing_foot_says_so() {
+    let mut h = Harness::dynamic("jvrc1", 500.0);
+    let knee = h
+        .robot
+        .model
+        .joint_names()
+        .iter()
+        .position(|name| name == "R_KNEE")
+        .expect("JVRC-1 has R_KNEE");
+    let sequence = synthetic_walk(&h.robot, 2, 0.1, false);
+    h.start_dynamic(&sequence, &kinematic_gait_config("jvrc1"));
+    let mut lifted = false;
+    for _ in 0..10_000 {
+        h.closed
+            .tick_with(|readings| {
+                if lifted {
+                    readings.wrenches[EndEffector::RightFoot as usize] = [0.0; 6];
+                    readings.q[knee] += 0.3;
+                }
+            })
+            .expect("a command every tick");
+        assert!(h.closed.command.is_finite());
+        let status = h.closed.controller.status();
+        lifted |= !status.contacts[EndEffector::RightFoot as usize];
+        if !matches!(
+            status.state,
+            ControllerState::Executing | ControllerState::ControlledStop
+        ) {
+            break;
+        }
+    }
+    let status = h.closed.controller.status();
+    assert_eq!(status.state, ControllerState::Fault);
+    assert_eq!(status.fault, FaultCode::StopCouldNotLand);
+    assert_eq!(status.fault.code(), "stop_could_not_land");
+    assert!(
+        !status.contacts[EndEffector::RightFoot as usize],
+        "the foot that could not land is not in contact"
+    );
+}
+
 #[test]
 fn a_robot_without_a_dynamic_gait_refuses_a_dynamic_walk() {
     let h = Harness::new("jvrc1", 500.0);

@@ -250,7 +250,7 @@ impl Harness {
     /// the command.
     pub fn tick_with(&mut self, tamper: impl FnOnce(&mut [[f64; 6]; 4])) {
         self.closed
-            .tick_with(tamper)
+            .tick_with(|readings| tamper(readings.wrenches))
             .expect("the simulator's measurements are valid, so every tick commands");
     }
 
