@@ -253,7 +253,8 @@ pub struct DaemonStatus {
     pub left_foot: [f64; 7],
     /// Right sole pose: translation xyz + quaternion xyzw.
     pub right_foot: [f64; 7],
-    /// The fault not yet acknowledged: its first cause, then what followed from it (empty: none).
+    /// The standing condition hold and abort do not clear (another process on `sensors`), then
+    /// the fault not yet acknowledged: its first cause, then what followed from it (empty: none).
     pub fault: FixedText<FAULT_TEXT>,
     /// Adapter link as seen by the watchdog.
     pub link: Code<LinkState>,
@@ -267,7 +268,8 @@ pub struct DaemonStatus {
     pub stale_periods: u64,
     /// Times the sample watchdog tripped.
     pub watchdog_trips: u64,
-    /// Samples refused for their time stamp (in the future, or older than the last one).
+    /// Samples refused: for their time stamp (in the future, or older than the last one), for
+    /// their publisher (not the adapter walkd pinned), or the pinned adapter's sequence going back.
     pub rejected_samples: u64,
     /// Why the last sample was refused (empty: none yet).
     pub last_rejection: FixedText<96>,

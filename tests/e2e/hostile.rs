@@ -6,15 +6,17 @@
 use std::mem::offset_of;
 use std::time::{Duration, Instant};
 
+use client::daemon_client::DaemonClient;
+use client::process::Process;
 use kinematics::robot::Robot;
-use shm_types::{DaemonState, LinkState, SensorSample};
+use shm_types::{ControlCommand, DaemonState, JointCommand, LinkState, SensorSample};
 use walk_tests::hostile::{
-    Feeder, PortHog, Raw, RawAdapter, RawClient, RawDaemon, command_answers, command_q,
+    Feeder, PortHog, Raw, RawAdapter, RawClient, RawDaemon, Tap, command_answers, command_q,
     standing_sample,
 };
 use walk_tests::{
-    assert_terminates, config, start_connected, start_sim, start_walkd, unique_prefix,
-    wait_for_status, wait_until, walk_json,
+    assert_terminates, config, start_connected, start_sim, start_walkd, start_walking,
+    unique_prefix, wait_for_status, wait_until, walk_json,
 };
 
 const START: Duration = Duration::from_secs(20);
@@ -412,7 +414,8 @@ fn the_first_fault_cause_is_kept_and_done_clears_it() {
 }
 
 /// Item 8: one process holding many ports cannot lock monitoring out, and a second publisher
-/// on `sensors` is reported while the real adapter still connects.
+/// on `sensors` is reported (as an intruder: walkd follows the real adapter) while the real
+/// adapter still connects.
 #[test]
 fn a_greedy_process_cannot_lock_out_monitoring_or_the_adapter() {
     let prefix = unique_prefix("hostile_hog");
@@ -439,7 +442,10 @@ fn a_greedy_process_cannot_lock_out_monitoring_or_the_adapter() {
     .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
     let client = walk_tests::connect(&prefix).unwrap();
     let status = client.status().unwrap();
-    assert!(status.fault.as_str().contains("publishers"), "{status:?}");
+    assert!(
+        status.fault.as_str().contains("intruder on sensors"),
+        "{status:?}"
+    );
 }
 
 /// Item 9, the smaller defects: a refused submission uses up no sequence id; walkctl says at
@@ -486,4 +492,174 @@ fn refusals_use_no_id_a_dead_walkd_is_named_at_once_and_bad_commands_do_not_floo
         "{refusals} log lines for 500 bad commands\n{log}"
     );
     assert!(log.contains("mode holds 257"), "{log}");
+}
+
+/// The index of ARMAR-4's torso yaw joint: the joint the forgers turn.
+fn torso(robot: &Robot) -> usize {
+    robot
+        .model
+        .joint_names()
+        .iter()
+        .position(|n| n == "torso_yaw_joint")
+        .unwrap()
+}
+
+/// The largest change of any joint between two consecutive commands (rad).
+fn largest_step(commands: &[Raw<JointCommand>], dof: usize) -> f64 {
+    commands
+        .windows(2)
+        .flat_map(|pair| {
+            let (a, b) = (command_q(&pair[0], dof), command_q(&pair[1], dof));
+            a.into_iter().zip(b).map(|(a, b)| (a - b).abs())
+        })
+        .fold(0.0, f64::max)
+}
+
+/// How a forger's process is named in walkd's reports: the test process is the forger.
+fn forger_pid() -> String {
+    format!("pid {}", std::process::id())
+}
+
+/// A walk of ARMAR-4 under way, its commands tapped, and the posture a forger sends: standing,
+/// the torso turned 0.3 rad (inside the limits).
+struct ForgeryTarget {
+    prefix: String,
+    walkd: Process,
+    _sim: Process,
+    client: DaemonClient,
+    robot: Robot,
+    tap: Tap<JointCommand>,
+    /// Every command since the tap started.
+    commands: Vec<Raw<JointCommand>>,
+    /// The torso's command before the forgery.
+    torso_before: f64,
+    forged: SensorSample,
+}
+
+impl ForgeryTarget {
+    /// Starts walking 1 m on a prefix of `test`'s and taps the commands for half a second.
+    fn start(test: &str) -> Self {
+        let prefix = unique_prefix(test);
+        let (walkd, sim, client) = start_walking("armar4", &prefix, 1.0).unwrap();
+        let robot = robot("armar4");
+        let tap = Tap::<JointCommand>::start(&prefix, "commands", 128).unwrap();
+        std::thread::sleep(Duration::from_millis(500));
+        let commands = tap.take();
+        let last = commands.last().expect("commands while walking");
+        let torso_before = command_q(last, robot.model.dof())[torso(&robot)];
+        let mut forged = standing_sample(&robot);
+        forged.q[torso(&robot)] += 0.3;
+        Self {
+            prefix,
+            walkd,
+            _sim: sim,
+            client,
+            robot,
+            tap,
+            commands,
+            torso_before,
+            forged,
+        }
+    }
+
+    /// The commands walkd sent since the tap started continue smoothly (no step above 0.01 rad
+    /// between two), and none takes the forger's torso posture: every command's torso stays
+    /// within 0.05 rad of where it was before the forgery.
+    fn assert_commands_ignore_the_forger(&mut self) {
+        self.commands.extend(self.tap.take());
+        let (commands, log) = (&self.commands, self.walkd.log());
+        let dof = self.robot.model.dof();
+        assert!(
+            commands.len() > 100,
+            "only {} commands\n{log}",
+            commands.len()
+        );
+        let step = largest_step(commands, dof);
+        assert!(
+            step <= 0.01,
+            "a command jumped {step:.4} rad from the one before\n{log}"
+        );
+        let torso = torso(&self.robot);
+        let drift = commands
+            .iter()
+            .map(|c| (command_q(c, dof)[torso] - self.torso_before).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            drift < 0.05,
+            "the torso was commanded {drift:.3} rad from its posture before the forgery\n{log}"
+        );
+    }
+}
+
+/// Issue 20, defect 2: another process replays an adapter restart (its sequence starts at 1,
+/// the torso turned 0.3 rad, inside the limits) for 5 samples and leaves within 50 ms, during a
+/// walk. walkd pins the adapter it linked to: the forged samples are refused and counted, the
+/// commands stay continuous and never take the forged posture.
+#[test]
+fn a_forged_adapter_restart_does_not_move_the_robot() {
+    let mut walk = ForgeryTarget::start("hostile_forged_restart");
+    {
+        let mut forger = RawAdapter::open(&walk.prefix).unwrap();
+        let forging = Instant::now();
+        for _ in 0..5 {
+            forger.publish(&walk.forged, |_| {});
+            std::thread::sleep(PERIOD);
+        }
+        drop(forger);
+        assert!(forging.elapsed() < Duration::from_millis(50));
+    }
+    std::thread::sleep(Duration::from_secs(1));
+    walk.assert_commands_ignore_the_forger();
+    let (walkd, client) = (&walk.walkd, &walk.client);
+    let status = client.status().unwrap();
+    assert!(status.rejected_samples >= 5, "{status:?}\n{}", walkd.log());
+    assert!(
+        status.last_rejection.as_str().contains("publisher"),
+        "{status:?}"
+    );
+    assert_eq!(status.link, LinkState::Fresh, "{status:?}");
+}
+
+/// Issue 20, defects 2 and 4: a second process publishes on `sensors` during a walk (its own
+/// sequence from 1, another posture). Its samples never reach the controller; the walk is
+/// stopped with hold; the status names the intruder's process, also after hold; a new walk is
+/// refused naming it; once it is gone walkd walks again.
+#[test]
+fn a_second_publisher_on_sensors_is_refused_and_named_also_after_hold() {
+    let mut walk = ForgeryTarget::start("hostile_second_sensors");
+    let forger = Feeder::start(&walk.prefix, walk.forged, PERIOD).unwrap();
+    let (walkd, client) = (&walk.walkd, &walk.client);
+    let named = |s: &shm_types::DaemonStatus| s.fault.as_str().contains(&forger_pid());
+    wait_for_status(client, "the walk held, the intruder named", REPLY, |s| {
+        named(s) && s.state == DaemonState::Holding
+    })
+    .unwrap_or_else(|e| panic!("{e}: {:?}\n{}", client.status().ok(), walkd.log()));
+    let held = client.control(ControlCommand::Hold).unwrap();
+    std::thread::sleep(Duration::from_millis(200));
+    let status = client.status().unwrap();
+    assert!(
+        named(&held) && named(&status),
+        "hold hid the intruder: {held:?} / {status:?}"
+    );
+    let (json, _) = walk_json("armar4", 0.3).unwrap();
+    match client.submit_json(&json) {
+        Err(client::daemon_client::SubmitError::Refused(reason)) => {
+            assert!(reason.contains(&forger_pid()), "{reason}");
+        }
+        other => panic!("a walk was not refused while an intruder publishes: {other:?}"),
+    }
+    walk.assert_commands_ignore_the_forger();
+
+    drop(forger);
+    let (walkd, client) = (&walk.walkd, &walk.client);
+    let status = wait_for_status(client, "the intruder gone", REPLY, |s| !named(s))
+        .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    assert_eq!(status.link, LinkState::Fresh, "{status:?}");
+    client.control(ControlCommand::Hold).unwrap();
+    // Refused "just now" samples keep walks off for a moment after the intruder is gone.
+    wait_until("a walk accepted again", REPLY, || {
+        client.submit_json(&json).ok()
+    })
+    .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    assert!(walkd.is_running());
 }

@@ -8,7 +8,8 @@
 //! - the **main thread** ([`service`]) serves sequence submissions and control requests, publishes
 //!   the status at `[runtime] status_rate_hz`, and talks to systemd.
 //!
-//! They share only lock-free slots and atomics ([`shared`], [`handoff`], [`snapshot`]).
+//! They share only lock-free slots and atomics ([`shared`], [`handoff`], [`snapshot`], and
+//! [`trust`]: the adapter walkd follows, pinned by its iceoryx2 identity).
 //!
 //! Signals: SIGTERM / SIGINT → the controller holds, a final hold command and a final `stopping`
 //! status go out, services are released, exit 0.
@@ -28,6 +29,7 @@ mod shared;
 mod snapshot;
 mod stats;
 mod telemetry;
+mod trust;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

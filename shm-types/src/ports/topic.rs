@@ -8,6 +8,7 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::{Subscriber, SubscriberCreateError};
 use iceoryx2::prelude::*;
 
+use super::trust::PublisherId;
 use crate::services::{self, Access, IpcNode, PubSub, Topic};
 use crate::{ServiceNames, ShmError};
 
@@ -111,13 +112,23 @@ impl<T: Topic> TopicReceiver<T> {
     /// Passes every message received since the last call to `each`, oldest first; returns how
     /// many. No heap allocation.
     pub(crate) fn drain(&self, mut each: impl FnMut(&T)) -> Result<usize, ShmError> {
+        self.drain_from(|_, message| each(message))
+    }
+
+    /// Passes every message received since the last call to `each` with its publisher (the
+    /// connection it came through, not what the publisher wrote), oldest first per publisher;
+    /// returns how many. No heap allocation.
+    pub(crate) fn drain_from(
+        &self,
+        mut each: impl FnMut(PublisherId, &T),
+    ) -> Result<usize, ShmError> {
         let mut count = 0;
         while let Some(sample) = self
             .subscriber
             .receive()
             .map_err(|e| ShmError::ipc("receive from", &self.name, e))?
         {
-            each(sample.payload());
+            each(sample.origin().into(), sample.payload());
             count += 1;
         }
         Ok(count)
