@@ -9,7 +9,9 @@ use std::time::{Duration, Instant};
 use client::daemon_client::DaemonClient;
 use client::process::Process;
 use kinematics::robot::Robot;
-use shm_types::{ControlCommand, DaemonState, JointCommand, LinkState, SensorSample};
+use shm_types::{
+    Code, CommandMode, ControlCommand, DaemonState, JointCommand, LinkState, SensorSample,
+};
 use walk_tests::hostile::{
     Feeder, PortHog, Raw, RawAdapter, RawClient, RawDaemon, Tap, command_answers, command_q,
     standing_sample,
@@ -661,5 +663,48 @@ fn a_second_publisher_on_sensors_is_refused_and_named_also_after_hold() {
         client.submit_json(&json).ok()
     })
     .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    assert!(walkd.is_running());
+}
+
+/// Issue 20, deliverable 2: walk-sim pins the walkd it linked to. A second process publishing
+/// track commands (the torso turned 0.3 rad) does not move the simulated robot, and walk-sim
+/// names it in its log.
+#[test]
+fn walk_sim_follows_only_the_walkd_it_linked_to() {
+    let prefix = unique_prefix("hostile_forged_commands");
+    let (walkd, sim, client) = start_connected("armar4", &prefix, "realtime").unwrap();
+    let robot = robot("armar4");
+    let (dof, torso) = (robot.model.dof(), torso(&robot));
+    let samples = Tap::<SensorSample>::start(&prefix, "sensors", 128).unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    let q =
+        |s: &Raw<SensorSample>| s.get::<[f64; shm_types::MAX_JOINTS]>(offset_of!(SensorSample, q));
+    let torso_before = q(samples.take().last().expect("samples"))[torso];
+    let mut forger = RawDaemon::open(&prefix).unwrap();
+    let mut command = JointCommand::ZERO;
+    command.joint_count = dof as u32;
+    command.mode = Code::new(CommandMode::Track);
+    command.q_des[..dof].copy_from_slice(robot.standing.joints.as_slice());
+    command.q_des[torso] += 0.3;
+    for _ in 0..150 {
+        forger.publish(&command, |_| {});
+        std::thread::sleep(PERIOD);
+    }
+    let moved = samples
+        .take()
+        .iter()
+        .map(|s| (q(s)[torso] - torso_before).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        moved < 0.01,
+        "the forged commands turned the simulated torso {moved:.3} rad\n{}",
+        sim.log()
+    );
+    let log = sim.log();
+    assert!(
+        log.contains("refused") && log.contains(&forger_pid()),
+        "walk-sim did not name the second command publisher\n{log}"
+    );
+    assert_eq!(client.status().unwrap().link, LinkState::Fresh);
     assert!(walkd.is_running());
 }
