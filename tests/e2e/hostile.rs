@@ -11,10 +11,11 @@ use client::process::Process;
 use kinematics::robot::Robot;
 use shm_types::{
     Code, CommandMode, ControlCommand, DaemonState, JointCommand, LinkState, SensorSample,
+    Telemetry,
 };
 use walk_tests::hostile::{
-    Feeder, PortHog, Raw, RawAdapter, RawClient, RawDaemon, Tap, command_answers, command_q,
-    standing_sample,
+    Feeder, PortHog, Raw, RawAdapter, RawClient, RawDaemon, RawPublisher, Tap, command_answers,
+    command_q, standing_sample,
 };
 use walk_tests::{
     assert_terminates, config, start_connected, start_sim, start_walkd, start_walking,
@@ -664,6 +665,66 @@ fn a_second_publisher_on_sensors_is_refused_and_named_also_after_hold() {
     })
     .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
     assert!(walkd.is_running());
+}
+
+/// Issue 20, defect 3: a second process publishes on `telemetry` during a recorded walk, with
+/// sequence numbers near `u64::MAX`. The observer pinned walkd's telemetry publisher: it records
+/// none of the forged messages (no absurd loss count) and reports the intruder's process.
+#[test]
+fn a_second_telemetry_publisher_is_not_recorded_and_is_reported() {
+    let prefix = unique_prefix("hostile_second_telemetry");
+    let (walkd, _sim, _client) = start_walking("armar4", &prefix, 1.0).unwrap();
+    let file = std::env::temp_dir().join(format!(
+        "walk-e2e-second-telemetry-{}.mcap",
+        std::process::id()
+    ));
+    let recorder = {
+        let (prefix, file) = (prefix.clone(), file.display().to_string());
+        let config = config("armar4").display().to_string();
+        std::thread::spawn(move || {
+            walk_tests::run_walkctl(&[
+                "record",
+                "--config",
+                &config,
+                "--service-prefix",
+                &prefix,
+                "-o",
+                &file,
+                "--duration",
+                "3",
+                "--json",
+            ])
+        })
+    };
+    std::thread::sleep(Duration::from_millis(1000));
+    let mut forger = RawPublisher::<Telemetry>::open(&prefix, "telemetry").unwrap();
+    for i in 0..50u64 {
+        forger.publish(Telemetry::ZERO, |raw| {
+            raw.put(offset_of!(Telemetry, seq), u64::MAX - 23_727_245 + i);
+            raw.put(offset_of!(Telemetry, stance_count), 999u32);
+        });
+        std::thread::sleep(PERIOD);
+    }
+    let output = recorder
+        .join()
+        .unwrap()
+        .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    let _ = std::fs::remove_file(&file);
+    let report: serde_json::Value = serde_json::from_str(&output).unwrap();
+    let telemetry = &report["observer"]["telemetry"];
+    assert!(
+        telemetry["lost"].as_u64().unwrap() < 50,
+        "forged telemetry was recorded: {report}"
+    );
+    assert!(
+        telemetry["last_seq"].as_u64().unwrap() < 1 << 32,
+        "forged telemetry was recorded: {report}"
+    );
+    let intruders = report["observer"]["intruders"].to_string();
+    assert!(
+        intruders.contains("telemetry") && intruders.contains(&forger_pid()),
+        "the observer did not report the second telemetry publisher: {report}"
+    );
 }
 
 /// Issue 20, deliverable 2: walk-sim pins the walkd it linked to. A second process publishing

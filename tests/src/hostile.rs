@@ -6,6 +6,7 @@
 //! opens `T`'s services, but its bytes are written field by field at their offsets
 //! (`std::mem::offset_of!`), so a test can put any bit pattern where the contract expects an
 //! enum or a flag. [`RawAdapter`] publishes raw sensor samples and reads walkd's commands;
+//! [`RawPublisher`] publishes on any of walkd's streams (a second telemetry publisher);
 //! [`Tap`] keeps every message of a stream; [`RawClient`] sends raw control requests and
 //! submissions; [`PortHog`] holds ports to exhaust a service's capacity.
 
@@ -405,6 +406,31 @@ impl RawDaemon {
         raw.stamp(offset_of!(JointCommand, timestamp_ns));
         edit(&mut raw);
         self.commands.send(raw, offset_of!(JointCommand, seq));
+    }
+}
+
+/// A second publisher on one of walkd's services (e.g. `telemetry`), sending raw messages
+/// without a wake-up event.
+pub struct RawPublisher<T: Copy + ZeroCopySend + 'static> {
+    sender: RawSender<T>,
+    _node: Node<ipc::Service>,
+}
+
+impl<T: Copy + ZeroCopySend + 'static> RawPublisher<T> {
+    /// Opens the service `kind` under `prefix` (walkd created it) and publishes on it.
+    pub fn open(prefix: &str, kind: &str) -> anyhow::Result<Self> {
+        let node = node("hostile-publisher")?;
+        Ok(Self {
+            sender: RawSender::open(&node, prefix, kind, false)?,
+            _node: node,
+        })
+    }
+
+    /// Publishes `message` after `edit` changed its raw bytes (sequence number included).
+    pub fn publish(&mut self, message: T, edit: impl FnOnce(&mut Raw<T>)) {
+        let mut raw = Raw::of(message);
+        edit(&mut raw);
+        self.sender.send_as_is(raw);
     }
 }
 

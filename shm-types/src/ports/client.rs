@@ -12,7 +12,7 @@ use iceoryx2::port::client::Client;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::client::ClientCreateError;
 
-use super::topic::TopicReceiver;
+use super::trust::TrustedReceiver;
 use crate::services::{
     self, Access, ControlService, IpcNode, PubSub, SubmitService, Topic, capacity,
 };
@@ -30,13 +30,13 @@ type ControlClient = Client<ipc::Service, ControlRequest, (), ControlReply, ()>;
 /// [`connect`](Self::connect) fails with [`ShmError::NotRunning`].
 pub struct ClientPorts {
     names: ServiceNames,
-    status: OnceCell<TopicReceiver<DaemonStatus>>,
+    status: OnceCell<TrustedReceiver<DaemonStatus>>,
     stances: OnceCell<StancesClient>,
     control: OnceCell<ControlClient>,
     status_service: PubSub<DaemonStatus>,
     stances_service: SubmitService,
     control_service: ControlService,
-    _node: IpcNode,
+    node: IpcNode,
 }
 
 impl ClientPorts {
@@ -52,7 +52,7 @@ impl ClientPorts {
             status: OnceCell::new(),
             stances: OnceCell::new(),
             control: OnceCell::new(),
-            _node: node,
+            node,
         };
         // A full status service is reported when the status is asked for, not here.
         let _ = ports.status_subscriber();
@@ -66,9 +66,12 @@ impl ClientPorts {
             && self.stances_service.dynamic_config().number_of_servers() > 0
     }
 
-    fn status_subscriber(&self) -> Result<&TopicReceiver<DaemonStatus>, ShmError> {
+    /// The status subscriber: it takes the statuses of the first publisher heard (walkd's) and
+    /// refuses any other's.
+    fn status_subscriber(&self) -> Result<&TrustedReceiver<DaemonStatus>, ShmError> {
         created(&self.status, || {
-            TopicReceiver::subscribe(&self.names, &self.status_service, DaemonStatus::BUFFER)
+            let service = services::publish_subscribe(&self.node, &self.names, Access::OpenOnly)?;
+            TrustedReceiver::subscribe(&self.names, service, DaemonStatus::BUFFER, true)
         })
     }
 
@@ -97,7 +100,7 @@ impl ClientPorts {
     pub fn latest_status(&self) -> Result<Option<DaemonStatus>, ShmError> {
         let subscriber = self.status_subscriber()?;
         let mut status = DaemonStatus::INITIAL;
-        if !subscriber.take_latest(&mut status)? {
+        if !subscriber.take_latest(&mut status)?.any() {
             return Ok(None);
         }
         checked_status(subscriber.name(), status).map(Some)

@@ -133,10 +133,4 @@ impl<T: Topic> TopicReceiver<T> {
         }
         Ok(count)
     }
-
-    /// Copies the newest received message into `out`, dropping older ones; returns false when
-    /// nothing new arrived. No heap allocation.
-    pub(crate) fn take_latest(&self, out: &mut T) -> Result<bool, ShmError> {
-        Ok(self.drain(|message| *out = *message)? > 0)
-    }
 }
