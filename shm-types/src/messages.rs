@@ -253,8 +253,9 @@ pub struct DaemonStatus {
     pub left_foot: [f64; 7],
     /// Right sole pose: translation xyz + quaternion xyzw.
     pub right_foot: [f64; 7],
-    /// The standing condition hold and abort do not clear (another process on `sensors`), then
-    /// the fault not yet acknowledged: its first cause, then what followed from it (empty: none).
+    /// The standing conditions hold and abort do not clear (another process on `sensors`,
+    /// telemetry or status publication off), then the fault not yet acknowledged: its first
+    /// cause, then what followed from it (empty: none).
     pub fault: FixedText<FAULT_TEXT>,
     /// Adapter link as seen by the watchdog.
     pub link: Code<LinkState>,

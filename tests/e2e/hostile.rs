@@ -14,8 +14,8 @@ use shm_types::{
     Telemetry,
 };
 use walk_tests::hostile::{
-    Feeder, PortHog, Raw, RawAdapter, RawClient, RawDaemon, RawPublisher, Tap, command_answers,
-    command_q, standing_sample,
+    Feeder, MonitorHog, PortHog, Raw, RawAdapter, RawClient, RawDaemon, RawPublisher, Tap,
+    command_answers, command_q, standing_sample,
 };
 use walk_tests::{
     assert_terminates, config, start_connected, start_sim, start_walkd, start_walking,
@@ -724,6 +724,31 @@ fn a_second_telemetry_publisher_is_not_recorded_and_is_reported() {
     assert!(
         intruders.contains("telemetry") && intruders.contains(&forger_pid()),
         "the observer did not report the second telemetry publisher: {report}"
+    );
+}
+
+/// Issue 20, defect 3: another process created `telemetry` and `status` before walkd and holds
+/// every publisher slot. Monitoring cannot stop control: walkd starts, says once that telemetry
+/// is off, and walks to the end.
+#[test]
+fn held_monitoring_slots_do_not_stop_walkd() {
+    let prefix = unique_prefix("hostile_monitor_slots");
+    let hog = MonitorHog::take(&prefix).unwrap();
+    assert_eq!(hog.taken, (MonitorHog::SLOTS, MonitorHog::SLOTS));
+    let (walkd, _sim, client) = start_connected("armar4", &prefix, "lockstep")
+        .unwrap_or_else(|e| panic!("walkd did not start with the monitoring slots held: {e}"));
+    let (json, _) = walk_json("armar4", 0.3).unwrap();
+    let id = client.submit_json(&json).unwrap();
+    let done = client
+        .wait_for_sequence(id, Duration::from_secs(120), |_| {})
+        .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    assert_eq!(done.state, DaemonState::Done, "{done:?}\n{}", walkd.log());
+    assert!(done.fault.as_str().contains("telemetry off"), "{done:?}");
+    assert_eq!(
+        walkd.log().matches("telemetry off").count(),
+        1,
+        "{}",
+        walkd.log()
     );
 }
 

@@ -8,7 +8,7 @@
 //! enum or a flag. [`RawAdapter`] publishes raw sensor samples and reads walkd's commands;
 //! [`RawPublisher`] publishes on any of walkd's streams (a second telemetry publisher);
 //! [`Tap`] keeps every message of a stream; [`RawClient`] sends raw control requests and
-//! submissions; [`PortHog`] holds ports to exhaust a service's capacity.
+//! submissions; [`PortHog`] and [`MonitorHog`] hold ports to exhaust a service's capacity.
 
 use std::mem::{MaybeUninit, offset_of, size_of};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -23,8 +23,10 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::{publish_subscribe, request_response};
 use kinematics::robot::{EndEffector, Robot};
+use shm_types::services::{TELEMETRY_BUFFER, capacity};
 use shm_types::{
-    ControlReply, ControlRequest, DaemonStatus, JointCommand, MAX_JOINTS, SensorSample, SubmitReply,
+    ControlReply, ControlRequest, DaemonStatus, JointCommand, MAX_JOINTS, SensorSample,
+    SubmitReply, Telemetry,
 };
 
 /// The bytes of a message `T`, written and read at field offsets; never read as a `T`.
@@ -611,5 +613,56 @@ impl PortHog {
             _sensors: sensors,
             _node: node,
         })
+    }
+}
+
+/// Holds every publisher slot of walkd's monitoring services (`telemetry` and `status`), created
+/// before walkd starts with settings walkd accepts, as a process that got there first would.
+pub struct MonitorHog {
+    _telemetry: Vec<Publisher<ipc::Service, Raw<Telemetry>, ()>>,
+    _status: Vec<Publisher<ipc::Service, Raw<DaemonStatus>, ()>>,
+    /// Publisher slots taken: (telemetry, status).
+    pub taken: (usize, usize),
+    _node: Node<ipc::Service>,
+}
+
+impl MonitorHog {
+    /// Publisher slots of each service the hog creates (the ones walkd asks for).
+    pub const SLOTS: usize = 2;
+
+    /// Creates (or opens) `telemetry` and `status` under `prefix` and takes their publisher slots.
+    pub fn take(prefix: &str) -> anyhow::Result<Self> {
+        let node = node("hostile-monitor-hog")?;
+        let telemetry = Self::slots::<Telemetry>(&node, prefix, "telemetry")?;
+        let status = Self::slots::<DaemonStatus>(&node, prefix, "status")?;
+        Ok(Self {
+            taken: (telemetry.len(), status.len()),
+            _telemetry: telemetry,
+            _status: status,
+            _node: node,
+        })
+    }
+
+    /// Every publisher slot of the service `kind`, created with room for what walkd asks of it.
+    fn slots<T: Copy + ZeroCopySend + 'static>(
+        node: &Node<ipc::Service>,
+        prefix: &str,
+        kind: &str,
+    ) -> anyhow::Result<Vec<Publisher<ipc::Service, Raw<T>, ()>>> {
+        let service = node
+            .service_builder(&service_name(prefix, kind)?)
+            .publish_subscribe::<Raw<T>>()
+            .enable_safe_overflow(true)
+            .history_size(1)
+            .subscriber_max_buffer_size(TELEMETRY_BUFFER)
+            .subscriber_max_borrowed_samples(4)
+            .max_publishers(Self::SLOTS)
+            .max_subscribers(capacity::STATUS_SUBSCRIBERS)
+            .max_nodes(capacity::NODES)
+            .open_or_create()
+            .map_err(|e| anyhow::anyhow!("creating {kind}: {e:?}"))?;
+        Ok((0..Self::SLOTS)
+            .map_while(|_| service.publisher_builder().create().ok())
+            .collect())
     }
 }

@@ -10,7 +10,8 @@
 //!
 //! The service thread also lists the publishers on `sensors` for the control thread
 //! ([`AdapterWatch`]), and puts the standing conditions hold and abort do not clear in front of
-//! the status's fault text ([`Notices`]): another process publishing on `sensors`.
+//! the status's fault text ([`Notices`]): another process publishing on `sensors`, telemetry or
+//! status publication off.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -83,12 +84,22 @@ struct Requests {
 struct Notices {
     /// Who publishes on `sensors` (an intruder is named while it is there).
     adapters: AdapterWatch,
+    /// walkd found no free `telemetry` publisher slot (or could not open the service).
+    telemetry_off: bool,
+    /// walkd found no free `status` publisher slot: the status is only had by asking.
+    status_off: bool,
 }
 
 impl Notices {
     /// Puts the conditions in front of `status`'s fault text (cut at its capacity).
     fn apply(&self, status: &mut DaemonStatus) {
         let mut parts: Vec<String> = self.adapters.notice().into_iter().collect();
+        if self.telemetry_off {
+            parts.push("telemetry off (see walkd's log)".to_owned());
+        }
+        if self.status_off {
+            parts.push("status publication off (see walkd's log)".to_owned());
+        }
         if parts.is_empty() {
             return;
         }
@@ -100,14 +111,16 @@ impl Notices {
 }
 
 impl ServiceLoop {
-    /// Sets up the service side.
+    /// Sets up the service side; `telemetry_off`: the control thread publishes no telemetry.
     pub fn new(
         ports: DaemonServicePorts,
         shared: Arc<Shared>,
         status_in: SnapshotReader<DaemonStatus>,
         acceptance: Acceptance,
         status_rate_hz: f64,
+        telemetry_off: bool,
     ) -> Self {
+        let status_off = ports.status_off().is_some();
         Self {
             ports,
             requests: Requests {
@@ -116,6 +129,8 @@ impl ServiceLoop {
                 acceptance,
                 notices: Notices {
                     adapters: AdapterWatch::new(),
+                    telemetry_off,
+                    status_off,
                 },
                 next_sequence_id: 1,
                 next_ticket: 1,

@@ -23,30 +23,41 @@ use crate::{
 /// 0.10 loan allocates one small block (`tests/pinned_samples_allocation.rs` counts the take).
 ///
 /// Samples are taken only from the adapter's publisher pinned on the first sample; the others
-/// are refused and counted ([`Pin`]).
+/// are refused and counted ([`Pin`]). Telemetry is for observers only: when its service cannot
+/// be opened or has no free publisher slot, the ports open without it and say why
+/// ([`telemetry_off`](Self::telemetry_off)).
 pub struct DaemonLoopPorts {
     sensors: StreamReceiver<SensorSample>,
     commands: StreamSender<JointCommand>,
-    telemetry: TopicSender<Telemetry>,
+    telemetry: Result<TopicSender<Telemetry>, ShmError>,
     _node: IpcNode,
 }
 
 impl DaemonLoopPorts {
-    /// Opens (or creates) `sensors`, `commands` and `telemetry` under `names`.
+    /// Opens (or creates) `sensors` and `commands` under `names`, and `telemetry` if it can.
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, _) = services::create_node(node_name)?;
         Ok(Self {
             sensors: StreamReceiver::open(&node, names, false)?,
             commands: StreamSender::open(&node, names)?,
-            telemetry: TopicSender::open(&node, names, 1)?,
+            telemetry: TopicSender::open(&node, names, 1),
             _node: node,
         })
     }
 
+    /// Why there is no telemetry (its service could not be opened, or every publisher slot of it
+    /// is taken); `None` while it is published.
+    pub fn telemetry_off(&self) -> Option<&ShmError> {
+        self.telemetry.as_ref().err()
+    }
+
     /// Writes one tick's telemetry in place and publishes it to the observers (no wake-up, no
-    /// system call). Call it after the tick's command was sent.
+    /// system call); nothing without telemetry. Call it after the tick's command was sent.
     pub fn publish_telemetry(&self, fill: impl FnOnce(&mut Telemetry)) -> Result<(), ShmError> {
-        self.telemetry.send(fill)
+        match &self.telemetry {
+            Ok(telemetry) => telemetry.send(fill),
+            Err(_) => Ok(()),
+        }
     }
 
     /// Blocks until the adapter announces a sample or `timeout` passes.
@@ -83,10 +94,14 @@ impl DaemonLoopPorts {
 
 /// The service thread's ports: status out, sequence submissions and control requests in, and
 /// the roster of `sensors`.
+///
+/// The status is for monitoring: when its service has no free publisher slot, the ports open
+/// without it and say why ([`status_off`](Self::status_off)); clients then get the status with
+/// their control queries.
 pub struct DaemonServicePorts {
     stances_name: String,
     control_name: String,
-    status: TopicSender<DaemonStatus>,
+    status: Result<TopicSender<DaemonStatus>, ShmError>,
     stances: Server<ipc::Service, [u8], (), SubmitReply, ()>,
     control: Server<ipc::Service, ControlRequest, (), ControlReply, ()>,
     sensors: PubSub<SensorSample>,
@@ -96,11 +111,12 @@ pub struct DaemonServicePorts {
 }
 
 impl DaemonServicePorts {
-    /// Opens (or creates) `status`, `stances`, `control` and `sensors` under `names`.
+    /// Opens (or creates) `stances`, `control` and `sensors` under `names`, and publishes on
+    /// `status` if it can.
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, cleaned_dead_nodes) = services::create_node(node_name)?;
         let (stances_name, control_name) = (names.full("stances"), names.full("control"));
-        let status = TopicSender::open(&node, names, 2)?;
+        let status = TopicSender::open(&node, names, 2);
         let sensors = services::publish_subscribe(&node, names, Access::OpenOrCreate)?;
         let stances_service = services::stances(&node, names, Access::OpenOrCreate)?;
         let control_service = services::control(&node, names, Access::OpenOrCreate)?;
@@ -130,9 +146,18 @@ impl DaemonServicePorts {
         self.cleaned_dead_nodes
     }
 
-    /// Publishes a status snapshot.
+    /// Why the status is not published (no free publisher slot, or its service could not be
+    /// opened); `None` while it is.
+    pub fn status_off(&self) -> Option<&ShmError> {
+        self.status.as_ref().err()
+    }
+
+    /// Publishes a status snapshot (nothing while the status is off).
     pub fn publish_status(&self, status: &DaemonStatus) -> Result<(), ShmError> {
-        self.status.send_copy(status)
+        match &self.status {
+            Ok(sender) => sender.send_copy(status),
+            Err(_) => Ok(()),
+        }
     }
 
     /// The publishers on `sensors` now, and whether `pinned` (the control thread's adapter) is

@@ -4,7 +4,7 @@
 //! A port keeps its service alive (iceoryx2 ports share the service's state), so neither holds the
 //! port factory it was created from.
 
-use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::publisher::{Publisher, PublisherCreateError};
 use iceoryx2::port::subscriber::{Subscriber, SubscriberCreateError};
 use iceoryx2::prelude::*;
 
@@ -27,11 +27,19 @@ impl<T: Topic> TopicSender<T> {
         loans: usize,
     ) -> Result<Self, ShmError> {
         let name = names.full(T::KIND);
-        let publisher = services::publish_subscribe::<T>(node, names, Access::OpenOrCreate)?
+        let service = services::publish_subscribe::<T>(node, names, Access::OpenOrCreate)?;
+        let publisher = service
             .publisher_builder()
             .max_loaned_samples(loans)
             .create()
-            .map_err(|e| ShmError::ipc("create publisher on", &name, e))?;
+            .map_err(|e| match e {
+                PublisherCreateError::ExceedsMaxSupportedPublishers => ShmError::ServiceFull {
+                    service: name.clone(),
+                    port: "publisher",
+                    limit: service.static_config().max_publishers(),
+                },
+                other => ShmError::ipc("create publisher on", &name, other),
+            })?;
         Ok(Self { name, publisher })
     }
 
