@@ -35,8 +35,8 @@ mod text;
 pub mod wire;
 
 pub use ports::{
-    AdapterPorts, ClientPorts, DaemonLoopPorts, DaemonServicePorts, Observed, ObserverPorts,
-    TruthPublisher, TruthSubscriber,
+    AdapterPorts, ClientPorts, DaemonLoopPorts, DaemonServicePorts, Observed, ObserverPorts, Peer,
+    Pin, PublisherId, Refusals, Roster, TruthPublisher, TruthSubscriber,
 };
 
 pub use clock::{current_thread_is_fifo, monotonic_ns, sleep_then_spin_until, sleep_until};

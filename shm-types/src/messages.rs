@@ -257,7 +257,9 @@ pub struct DaemonStatus {
     pub left_foot: [f64; 7],
     /// Right sole pose: translation xyz + quaternion xyzw.
     pub right_foot: [f64; 7],
-    /// The fault not yet acknowledged: its first cause, then what followed from it (empty: none).
+    /// The standing conditions hold and abort do not clear (another process on `sensors`,
+    /// telemetry or status publication off), then the fault not yet acknowledged: its first
+    /// cause, then what followed from it (empty: none).
     pub fault: FixedText<FAULT_TEXT>,
     /// Duration of the current or last controlled stop (s): from the fault or request that began
     /// it to rest on both feet (0: none since the last walk began).
@@ -274,7 +276,8 @@ pub struct DaemonStatus {
     pub stale_periods: u64,
     /// Times the sample watchdog tripped.
     pub watchdog_trips: u64,
-    /// Samples refused for their time stamp (in the future, or older than the last one).
+    /// Samples refused: for their time stamp (in the future, or older than the last one), for
+    /// their publisher (not the adapter walkd pinned), or the pinned adapter's sequence going back.
     pub rejected_samples: u64,
     /// Why the last sample was refused (empty: none yet).
     pub last_rejection: FixedText<96>,

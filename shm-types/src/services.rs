@@ -33,8 +33,9 @@ pub struct ServiceNames {
 /// lists them.
 pub mod capacity {
     /// Publishers on `sensors` (the adapter; an adapter restarting while the dead one is
-    /// cleaned; spare) and on `commands` (walkd; a restarting walkd; spare). walkd refuses to
-    /// walk while `sensors` has more than one (see `DaemonLoopPorts::sensor_publishers`).
+    /// cleaned; spare) and on `commands` (walkd; a restarting walkd; spare). walkd takes samples
+    /// only from the adapter it pinned, and refuses to walk while `sensors` has another
+    /// publisher (see `DaemonServicePorts::review_sensors`).
     pub const STREAM_PUBLISHERS: usize = 4;
     /// Subscribers of `sensors` and `commands`: walkd or the adapter, plus observers.
     pub const STREAM_SUBSCRIBERS: usize = 16;
@@ -128,6 +129,23 @@ pub fn create_node(name: &str) -> Result<(IpcNode, u64), ShmError> {
         .map_err(|e| ShmError::ipc("create node", name, e))?;
     node.try_cleanup_dead_nodes();
     Ok((node, dead_before.saturating_sub(count_dead_nodes())))
+}
+
+/// Removes the resources of the nodes whose process died without releasing them (iceoryx2's
+/// dead-node detection): their ports leave every service.
+pub(crate) fn remove_dead_nodes() {
+    let mut dead = Vec::new();
+    // A failing listing only means there is nothing to remove.
+    let _ = IpcNode::list(Config::global_config(), |state| {
+        if let NodeState::Dead(node) = state {
+            dead.push(node);
+        }
+        CallbackProgression::Continue
+    });
+    for node in dead {
+        // Another process cleaning it, or no permission: it stays listed, and counts.
+        let _ = node.try_remove_stale_resources();
+    }
 }
 
 /// Number of nodes whose process died without releasing them.

@@ -43,6 +43,8 @@ pub struct AdapterReport {
     pub overruns: u64,
     /// Commands refused: an unknown mode, or a setpoint the robot rejected (NaN, wrong size).
     pub refused_commands: u64,
+    /// Commands of another publisher than the daemon the adapter pinned (never applied).
+    pub foreign_commands: u64,
 }
 
 /// Why the loop stopped early.
@@ -126,6 +128,7 @@ struct Adapter<'a, R: RobotIo> {
     setpoint: Setpoint,
     report: AdapterReport,
     refusals: Throttle,
+    foreign: Throttle,
 }
 
 impl<R: RobotIo> Adapter<'_, R> {
@@ -174,9 +177,12 @@ impl<R: RobotIo> Adapter<'_, R> {
         self.setpoint.hold(&self.sample);
     }
 
-    /// Takes a fresh command if one arrived (in lockstep only the one answering our last sample).
+    /// Takes a fresh command of the pinned daemon if one arrived (in lockstep only the one
+    /// answering our last sample).
     fn take_command(&mut self, must_answer_last: bool) -> Result<bool, ShmError> {
-        if !self.ports.take_latest_command(&mut self.command)? {
+        let fresh = self.ports.take_latest_command(&mut self.command)?;
+        self.note_foreign_commands();
+        if !fresh {
             return Ok(false);
         }
         if must_answer_last && self.command.answers_seq != self.sample.seq {
@@ -201,6 +207,29 @@ impl<R: RobotIo> Adapter<'_, R> {
         }
         self.report.commands += 1;
         Ok(true)
+    }
+
+    /// Counts the commands the ports refused as another publisher's and logs who sent them
+    /// (throttled like [`Throttle`]).
+    fn note_foreign_commands(&mut self) {
+        let refusals = self.ports.command_refusals();
+        if refusals.count <= self.report.foreign_commands {
+            return;
+        }
+        self.report.foreign_commands = refusals.count;
+        if let Some(suppressed) = self.foreign.due() {
+            let from = refusals
+                .last
+                .map(|peer| peer.to_string())
+                .unwrap_or_default();
+            tracing::error!(
+                %from,
+                node = %format_args!("{:x}", refusals.last.map_or(0, |peer| peer.node())),
+                total = refusals.count,
+                since_last_report = suppressed,
+                "commands of another publisher refused: following only the daemon linked to"
+            );
+        }
     }
 
     fn run_realtime(&mut self, should_stop: &dyn Fn() -> bool) -> Result<(), ShmError> {
@@ -270,8 +299,11 @@ fn wait_for_deadline(deadline_ns: u64, spin_ns: u64, should_stop: &dyn Fn() -> b
     }
 }
 
-/// Runs the adapter until `should_stop()` says so: publishes samples of `robot`, applies the daemon's
-/// commands, and holds position whenever commands go stale (also before the first command).
+/// Runs the adapter until `should_stop()` says so: publishes samples of `robot`, applies the
+/// commands of the daemon it pinned (the first publisher heard on `commands`; another
+/// publisher's commands are refused, counted and logged, and the next daemon is followed once
+/// the pinned one is gone), and holds position whenever commands go stale (also before the
+/// first command).
 pub fn run_adapter<R: RobotIo>(
     ports: &AdapterPorts,
     robot: &mut R,
@@ -297,6 +329,7 @@ pub fn run_adapter<R: RobotIo>(
         },
         report: AdapterReport::default(),
         refusals: Throttle::new(),
+        foreign: Throttle::new(),
     };
     adapter.robot.read(&mut adapter.sample);
     adapter.setpoint.hold(&adapter.sample);

@@ -6,15 +6,20 @@
 use std::mem::offset_of;
 use std::time::{Duration, Instant};
 
+use client::daemon_client::DaemonClient;
+use client::process::Process;
 use kinematics::robot::Robot;
-use shm_types::{DaemonState, LinkState, SensorSample};
+use shm_types::{
+    Code, CommandMode, ControlCommand, DaemonState, JointCommand, LinkState, SensorSample,
+    Telemetry,
+};
 use walk_tests::hostile::{
-    Feeder, PortHog, Raw, RawAdapter, RawClient, RawDaemon, command_answers, command_q,
-    standing_sample,
+    Feeder, MonitorHog, PortHog, Raw, RawAdapter, RawClient, RawDaemon, RawPublisher, Tap,
+    command_answers, command_q, standing_sample,
 };
 use walk_tests::{
-    assert_terminates, config, start_connected, start_sim, start_walkd, unique_prefix,
-    wait_for_status, wait_until, walk_json,
+    assert_terminates, config, start_connected, start_sim, start_walkd, start_walking,
+    unique_prefix, wait_for_status, wait_until, walk_json,
 };
 
 const START: Duration = Duration::from_secs(20);
@@ -412,7 +417,8 @@ fn the_first_fault_cause_is_kept_and_done_clears_it() {
 }
 
 /// Item 8: one process holding many ports cannot lock monitoring out, and a second publisher
-/// on `sensors` is reported while the real adapter still connects.
+/// on `sensors` is reported (as an intruder: walkd follows the real adapter) while the real
+/// adapter still connects.
 #[test]
 fn a_greedy_process_cannot_lock_out_monitoring_or_the_adapter() {
     let prefix = unique_prefix("hostile_hog");
@@ -439,7 +445,10 @@ fn a_greedy_process_cannot_lock_out_monitoring_or_the_adapter() {
     .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
     let client = walk_tests::connect(&prefix).unwrap();
     let status = client.status().unwrap();
-    assert!(status.fault.as_str().contains("publishers"), "{status:?}");
+    assert!(
+        status.fault.as_str().contains("intruder on sensors"),
+        "{status:?}"
+    );
 }
 
 /// Item 9, the smaller defects: a refused submission uses up no sequence id; walkctl says at
@@ -486,4 +495,302 @@ fn refusals_use_no_id_a_dead_walkd_is_named_at_once_and_bad_commands_do_not_floo
         "{refusals} log lines for 500 bad commands\n{log}"
     );
     assert!(log.contains("mode holds 257"), "{log}");
+}
+
+/// The index of ARMAR-4's torso yaw joint: the joint the forgers turn.
+fn torso(robot: &Robot) -> usize {
+    robot
+        .model
+        .joint_names()
+        .iter()
+        .position(|n| n == "torso_yaw_joint")
+        .unwrap()
+}
+
+/// The largest change of any joint between two consecutive commands (rad).
+fn largest_step(commands: &[Raw<JointCommand>], dof: usize) -> f64 {
+    commands
+        .windows(2)
+        .flat_map(|pair| {
+            let (a, b) = (command_q(&pair[0], dof), command_q(&pair[1], dof));
+            a.into_iter().zip(b).map(|(a, b)| (a - b).abs())
+        })
+        .fold(0.0, f64::max)
+}
+
+/// How a forger's process is named in walkd's reports: the test process is the forger.
+fn forger_pid() -> String {
+    format!("pid {}", std::process::id())
+}
+
+/// A walk of ARMAR-4 under way, its commands tapped, and the posture a forger sends: standing,
+/// the torso turned 0.3 rad (inside the limits).
+struct ForgeryTarget {
+    prefix: String,
+    walkd: Process,
+    _sim: Process,
+    client: DaemonClient,
+    robot: Robot,
+    tap: Tap<JointCommand>,
+    /// Every command since the tap started.
+    commands: Vec<Raw<JointCommand>>,
+    /// The torso's command before the forgery.
+    torso_before: f64,
+    forged: SensorSample,
+}
+
+impl ForgeryTarget {
+    /// Starts walking 1 m on a prefix of `test`'s and taps the commands for half a second.
+    fn start(test: &str) -> Self {
+        let prefix = unique_prefix(test);
+        let (walkd, sim, client) = start_walking("armar4", &prefix, 1.0).unwrap();
+        let robot = robot("armar4");
+        let tap = Tap::<JointCommand>::start(&prefix, "commands", 128).unwrap();
+        std::thread::sleep(Duration::from_millis(500));
+        let commands = tap.take();
+        let last = commands.last().expect("commands while walking");
+        let torso_before = command_q(last, robot.model.dof())[torso(&robot)];
+        let mut forged = standing_sample(&robot);
+        forged.q[torso(&robot)] += 0.3;
+        Self {
+            prefix,
+            walkd,
+            _sim: sim,
+            client,
+            robot,
+            tap,
+            commands,
+            torso_before,
+            forged,
+        }
+    }
+
+    /// The commands walkd sent since the tap started continue smoothly (no step above 0.01 rad
+    /// between two), and none takes the forger's torso posture: every command's torso stays
+    /// within 0.05 rad of where it was before the forgery.
+    fn assert_commands_ignore_the_forger(&mut self) {
+        self.commands.extend(self.tap.take());
+        let (commands, log) = (&self.commands, self.walkd.log());
+        let dof = self.robot.model.dof();
+        assert!(
+            commands.len() > 100,
+            "only {} commands\n{log}",
+            commands.len()
+        );
+        let step = largest_step(commands, dof);
+        assert!(
+            step <= 0.01,
+            "a command jumped {step:.4} rad from the one before\n{log}"
+        );
+        let torso = torso(&self.robot);
+        let drift = commands
+            .iter()
+            .map(|c| (command_q(c, dof)[torso] - self.torso_before).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            drift < 0.05,
+            "the torso was commanded {drift:.3} rad from its posture before the forgery\n{log}"
+        );
+    }
+}
+
+/// Issue 20, defect 2: another process replays an adapter restart (its sequence starts at 1,
+/// the torso turned 0.3 rad, inside the limits) for 5 samples and leaves within 50 ms, during a
+/// walk. walkd pins the adapter it linked to: the forged samples are refused and counted, the
+/// commands stay continuous and never take the forged posture.
+#[test]
+fn a_forged_adapter_restart_does_not_move_the_robot() {
+    let mut walk = ForgeryTarget::start("hostile_forged_restart");
+    {
+        let mut forger = RawAdapter::open(&walk.prefix).unwrap();
+        let forging = Instant::now();
+        for _ in 0..5 {
+            forger.publish(&walk.forged, |_| {});
+            std::thread::sleep(PERIOD);
+        }
+        drop(forger);
+        assert!(forging.elapsed() < Duration::from_millis(50));
+    }
+    std::thread::sleep(Duration::from_secs(1));
+    walk.assert_commands_ignore_the_forger();
+    let (walkd, client) = (&walk.walkd, &walk.client);
+    let status = client.status().unwrap();
+    assert!(status.rejected_samples >= 5, "{status:?}\n{}", walkd.log());
+    assert!(
+        status.last_rejection.as_str().contains("publisher"),
+        "{status:?}"
+    );
+    assert_eq!(status.link, LinkState::Fresh, "{status:?}");
+}
+
+/// Issue 20, defects 2 and 4: a second process publishes on `sensors` during a walk (its own
+/// sequence from 1, another posture). Its samples never reach the controller; the walk is
+/// stopped with hold; the status names the intruder's process, also after hold; a new walk is
+/// refused naming it; once it is gone walkd walks again.
+#[test]
+fn a_second_publisher_on_sensors_is_refused_and_named_also_after_hold() {
+    let mut walk = ForgeryTarget::start("hostile_second_sensors");
+    let forger = Feeder::start(&walk.prefix, walk.forged, PERIOD).unwrap();
+    let (walkd, client) = (&walk.walkd, &walk.client);
+    let named = |s: &shm_types::DaemonStatus| s.fault.as_str().contains(&forger_pid());
+    wait_for_status(client, "the walk held, the intruder named", REPLY, |s| {
+        named(s) && s.state == DaemonState::Holding
+    })
+    .unwrap_or_else(|e| panic!("{e}: {:?}\n{}", client.status().ok(), walkd.log()));
+    let held = client.control(ControlCommand::Hold).unwrap();
+    std::thread::sleep(Duration::from_millis(200));
+    let status = client.status().unwrap();
+    assert!(
+        named(&held) && named(&status),
+        "hold hid the intruder: {held:?} / {status:?}"
+    );
+    let (json, _) = walk_json("armar4", 0.3).unwrap();
+    match client.submit_json(&json) {
+        Err(client::daemon_client::SubmitError::Refused(reason)) => {
+            assert!(reason.contains(&forger_pid()), "{reason}");
+        }
+        other => panic!("a walk was not refused while an intruder publishes: {other:?}"),
+    }
+    walk.assert_commands_ignore_the_forger();
+
+    drop(forger);
+    let (walkd, client) = (&walk.walkd, &walk.client);
+    let status = wait_for_status(client, "the intruder gone", REPLY, |s| !named(s))
+        .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    assert_eq!(status.link, LinkState::Fresh, "{status:?}");
+    client.control(ControlCommand::Hold).unwrap();
+    // Refused "just now" samples keep walks off for a moment after the intruder is gone.
+    wait_until("a walk accepted again", REPLY, || {
+        client.submit_json(&json).ok()
+    })
+    .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    assert!(walkd.is_running());
+}
+
+/// Issue 20, defect 3: a second process publishes on `telemetry` during a recorded walk, with
+/// sequence numbers near `u64::MAX`. The observer pinned walkd's telemetry publisher: it records
+/// none of the forged messages (no absurd loss count) and reports the intruder's process.
+#[test]
+fn a_second_telemetry_publisher_is_not_recorded_and_is_reported() {
+    let prefix = unique_prefix("hostile_second_telemetry");
+    let (walkd, _sim, _client) = start_walking("armar4", &prefix, 1.0).unwrap();
+    let file = std::env::temp_dir().join(format!(
+        "walk-e2e-second-telemetry-{}.mcap",
+        std::process::id()
+    ));
+    let recorder = {
+        let (prefix, file) = (prefix.clone(), file.display().to_string());
+        let config = config("armar4").display().to_string();
+        std::thread::spawn(move || {
+            walk_tests::run_walkctl(&[
+                "record",
+                "--config",
+                &config,
+                "--service-prefix",
+                &prefix,
+                "-o",
+                &file,
+                "--duration",
+                "3",
+                "--json",
+            ])
+        })
+    };
+    std::thread::sleep(Duration::from_millis(1000));
+    let mut forger = RawPublisher::<Telemetry>::open(&prefix, "telemetry").unwrap();
+    for i in 0..50u64 {
+        forger.publish(Telemetry::ZERO, |raw| {
+            raw.put(offset_of!(Telemetry, seq), u64::MAX - 23_727_245 + i);
+            raw.put(offset_of!(Telemetry, stance_count), 999u32);
+        });
+        std::thread::sleep(PERIOD);
+    }
+    let output = recorder
+        .join()
+        .unwrap()
+        .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    let _ = std::fs::remove_file(&file);
+    let report: serde_json::Value = serde_json::from_str(&output).unwrap();
+    let telemetry = &report["observer"]["telemetry"];
+    assert!(
+        telemetry["lost"].as_u64().unwrap() < 50,
+        "forged telemetry was recorded: {report}"
+    );
+    assert!(
+        telemetry["last_seq"].as_u64().unwrap() < 1 << 32,
+        "forged telemetry was recorded: {report}"
+    );
+    let intruders = report["observer"]["intruders"].to_string();
+    assert!(
+        intruders.contains("telemetry") && intruders.contains(&forger_pid()),
+        "the observer did not report the second telemetry publisher: {report}"
+    );
+}
+
+/// Issue 20, defect 3: another process created `telemetry` and `status` before walkd and holds
+/// every publisher slot. Monitoring cannot stop control: walkd starts, says once that telemetry
+/// is off, and walks to the end.
+#[test]
+fn held_monitoring_slots_do_not_stop_walkd() {
+    let prefix = unique_prefix("hostile_monitor_slots");
+    let hog = MonitorHog::take(&prefix).unwrap();
+    assert_eq!(hog.taken, (MonitorHog::SLOTS, MonitorHog::SLOTS));
+    let (walkd, _sim, client) = start_connected("armar4", &prefix, "lockstep")
+        .unwrap_or_else(|e| panic!("walkd did not start with the monitoring slots held: {e}"));
+    let (json, _) = walk_json("armar4", 0.3).unwrap();
+    let id = client.submit_json(&json).unwrap();
+    let done = client
+        .wait_for_sequence(id, Duration::from_secs(120), |_| {})
+        .unwrap_or_else(|e| panic!("{e}\n{}", walkd.log()));
+    assert_eq!(done.state, DaemonState::Done, "{done:?}\n{}", walkd.log());
+    assert!(done.fault.as_str().contains("telemetry off"), "{done:?}");
+    assert_eq!(
+        walkd.log().matches("telemetry off").count(),
+        1,
+        "{}",
+        walkd.log()
+    );
+}
+
+/// Issue 20, deliverable 2: walk-sim pins the walkd it linked to. A second process publishing
+/// track commands (the torso turned 0.3 rad) does not move the simulated robot, and walk-sim
+/// names it in its log.
+#[test]
+fn walk_sim_follows_only_the_walkd_it_linked_to() {
+    let prefix = unique_prefix("hostile_forged_commands");
+    let (walkd, sim, client) = start_connected("armar4", &prefix, "realtime").unwrap();
+    let robot = robot("armar4");
+    let (dof, torso) = (robot.model.dof(), torso(&robot));
+    let samples = Tap::<SensorSample>::start(&prefix, "sensors", 128).unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    let q =
+        |s: &Raw<SensorSample>| s.get::<[f64; shm_types::MAX_JOINTS]>(offset_of!(SensorSample, q));
+    let torso_before = q(samples.take().last().expect("samples"))[torso];
+    let mut forger = RawDaemon::open(&prefix).unwrap();
+    let mut command = JointCommand::ZERO;
+    command.joint_count = dof as u32;
+    command.mode = Code::new(CommandMode::Track);
+    command.q_des[..dof].copy_from_slice(robot.standing.joints.as_slice());
+    command.q_des[torso] += 0.3;
+    for _ in 0..150 {
+        forger.publish(&command, |_| {});
+        std::thread::sleep(PERIOD);
+    }
+    let moved = samples
+        .take()
+        .iter()
+        .map(|s| (q(s)[torso] - torso_before).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        moved < 0.01,
+        "the forged commands turned the simulated torso {moved:.3} rad\n{}",
+        sim.log()
+    );
+    let log = sim.log();
+    assert!(
+        log.contains("refused") && log.contains(&forger_pid()),
+        "walk-sim did not name the second command publisher\n{log}"
+    );
+    assert_eq!(client.status().unwrap().link, LinkState::Fresh);
+    assert!(walkd.is_running());
 }

@@ -6,8 +6,9 @@
 //! opens `T`'s services, but its bytes are written field by field at their offsets
 //! (`std::mem::offset_of!`), so a test can put any bit pattern where the contract expects an
 //! enum or a flag. [`RawAdapter`] publishes raw sensor samples and reads walkd's commands;
-//! [`RawClient`] sends raw control requests and submissions, and holds ports to exhaust a
-//! service's capacity.
+//! [`RawPublisher`] publishes on any of walkd's streams (a second telemetry publisher);
+//! [`Tap`] keeps every message of a stream; [`RawClient`] sends raw control requests and
+//! submissions; [`PortHog`] and [`MonitorHog`] hold ports to exhaust a service's capacity.
 
 use std::mem::{MaybeUninit, offset_of, size_of};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -22,8 +23,10 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::{publish_subscribe, request_response};
 use kinematics::robot::{EndEffector, Robot};
+use shm_types::services::{TELEMETRY_BUFFER, capacity};
 use shm_types::{
-    ControlReply, ControlRequest, DaemonStatus, JointCommand, MAX_JOINTS, SensorSample, SubmitReply,
+    ControlReply, ControlRequest, DaemonStatus, JointCommand, MAX_JOINTS, SensorSample,
+    SubmitReply, Telemetry,
 };
 
 /// The bytes of a message `T`, written and read at field offsets; never read as a `T`.
@@ -149,32 +152,45 @@ pub fn standing_sample(robot: &Robot) -> SensorSample {
     sample
 }
 
-/// The sending end of one of walkd's streams (`sensors` or `commands`), with raw messages:
-/// publisher and wake-up notifier, numbering what it sends.
+/// The sending end of one of walkd's services, with raw messages: a publisher and, for the
+/// streams with a wake-up event (`sensors`, `commands`), its notifier; numbers what it sends.
 struct RawSender<T: Copy + ZeroCopySend + 'static> {
     publisher: Publisher<ipc::Service, Raw<T>, ()>,
-    notifier: Notifier<ipc::Service>,
+    notifier: Option<Notifier<ipc::Service>>,
     seq: u64,
 }
 
 impl<T: Copy + ZeroCopySend + 'static> RawSender<T> {
-    /// Opens the stream `kind` under `prefix` (its other end created it).
-    fn open(node: &Node<ipc::Service>, prefix: &str, kind: &str) -> anyhow::Result<Self> {
+    /// Opens the service `kind` under `prefix` (its other end created it), and its event if
+    /// `wakes`.
+    fn open(
+        node: &Node<ipc::Service>,
+        prefix: &str,
+        kind: &str,
+        wakes: bool,
+    ) -> anyhow::Result<Self> {
         let stream = open_stream::<T>(node, prefix, kind)?;
-        let event = node
-            .service_builder(&service_name(prefix, kind)?)
-            .event()
-            .open()
-            .map_err(|e| anyhow::anyhow!("opening the {kind} event: {e:?}"))?;
+        let notifier = if wakes {
+            let event = node
+                .service_builder(&service_name(prefix, kind)?)
+                .event()
+                .open()
+                .map_err(|e| anyhow::anyhow!("opening the {kind} event: {e:?}"))?;
+            Some(
+                event
+                    .notifier_builder()
+                    .create()
+                    .map_err(|e| anyhow::anyhow!("notifier on {kind}: {e:?}"))?,
+            )
+        } else {
+            None
+        };
         Ok(Self {
             publisher: stream
                 .publisher_builder()
                 .create()
                 .map_err(|e| anyhow::anyhow!("publisher on {kind}: {e:?}"))?,
-            notifier: event
-                .notifier_builder()
-                .create()
-                .map_err(|e| anyhow::anyhow!("notifier on {kind}: {e:?}"))?,
+            notifier,
             seq: 0,
         })
     }
@@ -183,10 +199,17 @@ impl<T: Copy + ZeroCopySend + 'static> RawSender<T> {
     fn send(&mut self, mut raw: Raw<T>, seq_offset: usize) -> u64 {
         self.seq += 1;
         raw.put(seq_offset, self.seq);
+        self.send_as_is(raw);
+        self.seq
+    }
+
+    /// Sends `raw` as it is (and wakes the subscribers if the service has an event).
+    fn send_as_is(&mut self, raw: Raw<T>) {
         let loan = self.publisher.loan_uninit().expect("loan a message");
         loan.write_payload(raw).send().expect("send a message");
-        self.notifier.notify().expect("notify");
-        self.seq
+        if let Some(notifier) = &self.notifier {
+            notifier.notify().expect("notify");
+        }
     }
 }
 
@@ -203,7 +226,7 @@ impl RawAdapter {
         let node = node("hostile-adapter")?;
         let commands = open_stream::<JointCommand>(&node, prefix, "commands")?;
         Ok(Self {
-            sensors: RawSender::open(&node, prefix, "sensors")?,
+            sensors: RawSender::open(&node, prefix, "sensors", true)?,
             commands: commands
                 .subscriber_builder()
                 .create()
@@ -275,8 +298,7 @@ impl RawAdapter {
 pub struct Feeder {
     template: Arc<Mutex<Raw<SensorSample>>>,
     commands: Arc<Mutex<Vec<Raw<JointCommand>>>>,
-    stop: Arc<AtomicBool>,
-    thread: Option<std::thread::JoinHandle<()>>,
+    _thread: PeerThread,
 }
 
 impl Feeder {
@@ -284,41 +306,23 @@ impl Feeder {
     pub fn start(prefix: &str, sample: SensorSample, period: Duration) -> anyhow::Result<Self> {
         let template = Arc::new(Mutex::new(Raw::of(sample)));
         let commands = Arc::new(Mutex::new(Vec::new()));
-        let stop = Arc::new(AtomicBool::new(false));
-        let (ready_tx, ready_rx) = std::sync::mpsc::channel();
         let thread = {
-            let (prefix, template, commands, stop) = (
-                prefix.to_owned(),
-                template.clone(),
-                commands.clone(),
-                stop.clone(),
-            );
-            std::thread::spawn(move || {
-                let mut adapter =
-                    match RawAdapter::open_when_ready(&prefix, Duration::from_secs(20)) {
-                        Ok(adapter) => {
-                            let _ = ready_tx.send(Ok(()));
-                            adapter
-                        }
-                        Err(error) => {
-                            let _ = ready_tx.send(Err(error));
-                            return;
-                        }
-                    };
-                while !stop.load(Ordering::Relaxed) {
+            let (prefix, template, commands) =
+                (prefix.to_owned(), template.clone(), commands.clone());
+            PeerThread::start(
+                move || RawAdapter::open_when_ready(&prefix, Duration::from_secs(20)),
+                move |adapter: &mut RawAdapter| {
                     let raw = template.lock().unwrap().clone();
                     adapter.publish_raw(raw);
                     std::thread::sleep(period);
                     commands.lock().unwrap().extend(adapter.commands());
-                }
-            })
+                },
+            )?
         };
-        ready_rx.recv()??;
         Ok(Self {
             template,
             commands,
-            stop,
-            thread: Some(thread),
+            _thread: thread,
         })
     }
 
@@ -333,7 +337,47 @@ impl Feeder {
     }
 }
 
-impl Drop for Feeder {
+/// A raw peer on a thread of its own (iceoryx2 ports cannot move between threads): its ports are
+/// opened there, then one round of its work runs after the other until it is dropped.
+struct PeerThread {
+    stop: Arc<AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl PeerThread {
+    /// Opens the peer's ports with `open` on a new thread and returns once they are open (or
+    /// failed to); then calls `round` with them until dropped (`round` paces itself).
+    fn start<P>(
+        open: impl FnOnce() -> anyhow::Result<P> + Send + 'static,
+        mut round: impl FnMut(&mut P) + Send + 'static,
+    ) -> anyhow::Result<Self> {
+        let stop = Arc::new(AtomicBool::new(false));
+        let (ready_tx, ready_rx) = std::sync::mpsc::channel();
+        let stopped = stop.clone();
+        let thread = std::thread::spawn(move || {
+            let mut ports = match open() {
+                Ok(ports) => {
+                    let _ = ready_tx.send(Ok(()));
+                    ports
+                }
+                Err(error) => {
+                    let _ = ready_tx.send(Err(error));
+                    return;
+                }
+            };
+            while !stopped.load(Ordering::Relaxed) {
+                round(&mut ports);
+            }
+        });
+        ready_rx.recv()??;
+        Ok(Self {
+            stop,
+            thread: Some(thread),
+        })
+    }
+}
+
+impl Drop for PeerThread {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::Relaxed);
         if let Some(thread) = self.thread.take() {
@@ -353,7 +397,7 @@ impl RawDaemon {
     pub fn open(prefix: &str) -> anyhow::Result<Self> {
         let node = node("hostile-daemon")?;
         Ok(Self {
-            commands: RawSender::open(&node, prefix, "commands")?,
+            commands: RawSender::open(&node, prefix, "commands", true)?,
             _node: node,
         })
     }
@@ -364,6 +408,78 @@ impl RawDaemon {
         raw.stamp(offset_of!(JointCommand, timestamp_ns));
         edit(&mut raw);
         self.commands.send(raw, offset_of!(JointCommand, seq));
+    }
+}
+
+/// A second publisher on one of walkd's services (e.g. `telemetry`), sending raw messages
+/// without a wake-up event.
+pub struct RawPublisher<T: Copy + ZeroCopySend + 'static> {
+    sender: RawSender<T>,
+    _node: Node<ipc::Service>,
+}
+
+impl<T: Copy + ZeroCopySend + 'static> RawPublisher<T> {
+    /// Opens the service `kind` under `prefix` (walkd created it) and publishes on it.
+    pub fn open(prefix: &str, kind: &str) -> anyhow::Result<Self> {
+        let node = node("hostile-publisher")?;
+        Ok(Self {
+            sender: RawSender::open(&node, prefix, kind, false)?,
+            _node: node,
+        })
+    }
+
+    /// Publishes `message` after `edit` changed its raw bytes (sequence number included).
+    pub fn publish(&mut self, message: T, edit: impl FnOnce(&mut Raw<T>)) {
+        let mut raw = Raw::of(message);
+        edit(&mut raw);
+        self.sender.send_as_is(raw);
+    }
+}
+
+/// A subscriber of one of walkd's streams on a thread of its own that keeps every message (it
+/// drains every millisecond), so a test sees a whole stretch of the stream while it makes
+/// blocking requests.
+pub struct Tap<T: Copy + ZeroCopySend + Send + 'static> {
+    messages: Arc<Mutex<Vec<Raw<T>>>>,
+    _thread: PeerThread,
+}
+
+impl<T: Copy + ZeroCopySend + Send + 'static> Tap<T> {
+    /// Subscribes to the stream `kind` under `prefix` (holding up to `buffer` unread messages).
+    pub fn start(prefix: &str, kind: &str, buffer: usize) -> anyhow::Result<Self> {
+        let messages = Arc::new(Mutex::new(Vec::new()));
+        let thread = {
+            let (prefix, kind, messages) = (prefix.to_owned(), kind.to_owned(), messages.clone());
+            PeerThread::start(
+                move || {
+                    let node = node("hostile-tap")?;
+                    let subscriber = open_stream::<T>(&node, &prefix, &kind)?
+                        .subscriber_builder()
+                        .buffer_size(buffer)
+                        .create()
+                        .map_err(|e| anyhow::anyhow!("subscriber on {kind}: {e:?}"))?;
+                    Ok((node, subscriber))
+                },
+                move |(_, subscriber): &mut (
+                    Node<ipc::Service>,
+                    Subscriber<ipc::Service, Raw<T>, ()>,
+                )| {
+                    while let Ok(Some(sample)) = subscriber.receive() {
+                        messages.lock().unwrap().push(sample.payload().clone());
+                    }
+                    std::thread::sleep(Duration::from_millis(1));
+                },
+            )?
+        };
+        Ok(Self {
+            messages,
+            _thread: thread,
+        })
+    }
+
+    /// The messages received since the last call, oldest first.
+    pub fn take(&self) -> Vec<Raw<T>> {
+        std::mem::take(&mut *self.messages.lock().unwrap())
     }
 }
 
@@ -497,5 +613,56 @@ impl PortHog {
             _sensors: sensors,
             _node: node,
         })
+    }
+}
+
+/// Holds every publisher slot of walkd's monitoring services (`telemetry` and `status`), created
+/// before walkd starts with settings walkd accepts, as a process that got there first would.
+pub struct MonitorHog {
+    _telemetry: Vec<Publisher<ipc::Service, Raw<Telemetry>, ()>>,
+    _status: Vec<Publisher<ipc::Service, Raw<DaemonStatus>, ()>>,
+    /// Publisher slots taken: (telemetry, status).
+    pub taken: (usize, usize),
+    _node: Node<ipc::Service>,
+}
+
+impl MonitorHog {
+    /// Publisher slots of each service the hog creates (the ones walkd asks for).
+    pub const SLOTS: usize = 2;
+
+    /// Creates (or opens) `telemetry` and `status` under `prefix` and takes their publisher slots.
+    pub fn take(prefix: &str) -> anyhow::Result<Self> {
+        let node = node("hostile-monitor-hog")?;
+        let telemetry = Self::slots::<Telemetry>(&node, prefix, "telemetry")?;
+        let status = Self::slots::<DaemonStatus>(&node, prefix, "status")?;
+        Ok(Self {
+            taken: (telemetry.len(), status.len()),
+            _telemetry: telemetry,
+            _status: status,
+            _node: node,
+        })
+    }
+
+    /// Every publisher slot of the service `kind`, created with room for what walkd asks of it.
+    fn slots<T: Copy + ZeroCopySend + 'static>(
+        node: &Node<ipc::Service>,
+        prefix: &str,
+        kind: &str,
+    ) -> anyhow::Result<Vec<Publisher<ipc::Service, Raw<T>, ()>>> {
+        let service = node
+            .service_builder(&service_name(prefix, kind)?)
+            .publish_subscribe::<Raw<T>>()
+            .enable_safe_overflow(true)
+            .history_size(1)
+            .subscriber_max_buffer_size(TELEMETRY_BUFFER)
+            .subscriber_max_borrowed_samples(4)
+            .max_publishers(Self::SLOTS)
+            .max_subscribers(capacity::STATUS_SUBSCRIBERS)
+            .max_nodes(capacity::NODES)
+            .open_or_create()
+            .map_err(|e| anyhow::anyhow!("creating {kind}: {e:?}"))?;
+        Ok((0..Self::SLOTS)
+            .map_while(|_| service.publisher_builder().create().ok())
+            .collect())
     }
 }

@@ -1,8 +1,9 @@
 //! [`Observer`]: reads a running daemon's streams ([`super::source`]) and logs them on the
 //! Foxglove channels ([`super::channels`]) of a context, whose sinks decide where they go (an MCAP
-//! file, a WebSocket server, both).
+//! file, a WebSocket server, both). Messages another publisher sent on a stream are not recorded:
+//! the observer names that publisher on `/faults` and in its report.
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::thread::JoinHandle;
@@ -12,7 +13,7 @@ use anyhow::Context as _;
 use foxglove::Context;
 use foxglove::messages::log::Level;
 use kinematics::robot::Robot;
-use shm_types::{DaemonState, DaemonStatus, SensorSample};
+use shm_types::{DaemonState, DaemonStatus, Refusals, SensorSample};
 
 use super::channels::{Channels, Clock};
 use super::description::description_urdf;
@@ -71,6 +72,8 @@ struct Logger {
     recent: VecDeque<SensorSample>,
     report: ObserverReport,
     last_status: Option<(DaemonState, String)>,
+    /// Messages refused per stream, as reported last.
+    refused_seen: BTreeMap<String, u64>,
 }
 
 impl Logger {
@@ -82,6 +85,7 @@ impl Logger {
             recent: VecDeque::with_capacity(RECENT_SAMPLES),
             report: ObserverReport::default(),
             last_status: None,
+            refused_seen: BTreeMap::new(),
         }
     }
 
@@ -136,7 +140,34 @@ impl Logger {
             self.channels.log_status(status);
             self.log_changes(status);
         }
+        for (service, refusals) in &batch.refused {
+            self.note_intruder(service, refusals);
+        }
         Ok(())
+    }
+
+    /// Reports messages another publisher than the pinned one sent on `service` (refused, not
+    /// recorded): counted in the report, and logged on `/faults` when the publisher is new.
+    fn note_intruder(&mut self, service: &str, refusals: &Refusals) {
+        let Some(from) = refusals.last else {
+            return;
+        };
+        let kind = service.rsplit('/').next().unwrap_or(service);
+        let intruder = format!("{kind}: {from}");
+        let t = self.channels.clock().unix_ns(shm_types::monotonic_ns());
+        let seen = self.refused_seen.entry(service.to_owned()).or_default();
+        let new = refusals.count.saturating_sub(*seen);
+        *seen = refusals.count;
+        let known = self.report.intruders.contains_key(&intruder);
+        // What was refused since the last report is counted for its last sender.
+        *self.report.intruders.entry(intruder.clone()).or_default() += new;
+        if !known {
+            self.channels.log_fault(
+                Level::Error,
+                format!("{intruder} also publishes on {service}: its messages are not recorded"),
+                t,
+            );
+        }
     }
 
     /// Logs a state change (info) and a new fault (error) on `/faults`.

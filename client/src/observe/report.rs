@@ -1,6 +1,7 @@
 //! What an observer saw: per stream, how many messages arrived and how many it lost (gaps in the
 //! messages' sequence numbers).
 
+use std::collections::BTreeMap;
 use std::fmt;
 
 /// Received and lost messages of one stream, from its sequence numbers.
@@ -32,7 +33,7 @@ impl SeqTracker {
 }
 
 /// What one observation saw.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ObserverReport {
     /// Per-tick telemetry.
     pub telemetry: SeqTracker,
@@ -44,6 +45,9 @@ pub struct ObserverReport {
     pub statuses: u64,
     /// Ticks whose sample the observer did not have, so their link transforms were not logged.
     pub ticks_without_sample: u64,
+    /// Other publishers than the pinned ones, by stream (`telemetry: publisher … of pid …`):
+    /// messages refused and not recorded.
+    pub intruders: BTreeMap<String, u64>,
 }
 
 impl ObserverReport {
@@ -66,6 +70,7 @@ impl ObserverReport {
             "commands": stream(&self.commands),
             "statuses": self.statuses,
             "ticks_without_sample": self.ticks_without_sample,
+            "intruders": self.intruders,
         })
     }
 }
@@ -82,7 +87,11 @@ impl fmt::Display for ObserverReport {
         line(f, "telemetry", &self.telemetry)?;
         line(f, "samples", &self.samples)?;
         line(f, "commands", &self.commands)?;
-        write!(f, "  statuses   {:>8} received", self.statuses)
+        write!(f, "  statuses   {:>8} received", self.statuses)?;
+        for (intruder, refused) in &self.intruders {
+            write!(f, "\n  refused    {refused:>8} from {intruder}")?;
+        }
+        Ok(())
     }
 }
 

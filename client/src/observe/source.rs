@@ -1,6 +1,8 @@
 //! The observer's reading side: a thread that polls a running daemon's streams
 //! ([`shm_types::ObserverPorts`]) every [`POLL`] and hands each round's messages on as one
-//! [`Batch`], so decoding and writing never hold up the draining.
+//! [`Batch`], so decoding and writing never hold up the draining. Each stream's messages come
+//! from the one publisher the ports pinned (walkd's telemetry, commands and status); what other
+//! publishers send is refused and only reported.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -10,7 +12,8 @@ use std::time::Duration;
 
 use anyhow::Context;
 use shm_types::{
-    DaemonStatus, JointCommand, Observed, ObserverPorts, SensorSample, ServiceNames, Telemetry,
+    DaemonStatus, JointCommand, Observed, ObserverPorts, Refusals, SensorSample, ServiceNames,
+    Telemetry,
 };
 
 /// Nice value of the observer's threads: an observer yields the CPU to walkd and its adapter.
@@ -42,6 +45,9 @@ pub struct Batch {
     pub commands: Vec<JointCommand>,
     /// Statuses.
     pub statuses: Vec<DaemonStatus>,
+    /// Streams on which another publisher than the pinned one sent messages (refused, never
+    /// recorded): the service's full name and what was refused there so far.
+    pub refused: Vec<(String, Refusals)>,
 }
 
 impl Batch {
@@ -50,6 +56,7 @@ impl Batch {
             && self.samples.is_empty()
             && self.commands.is_empty()
             && self.statuses.is_empty()
+            && self.refused.is_empty()
     }
 }
 
@@ -115,6 +122,9 @@ fn poll(ports: &ObserverPorts, stop: &AtomicBool, batches: &Sender<Batch>) -> an
             Observed::Sample(s) => batch.samples.push(*s),
             Observed::Command(c) => batch.commands.push(*c),
             Observed::Status(s) => batch.statuses.push(*s),
+            Observed::Refused { service, refusals } => {
+                batch.refused.push((service.to_owned(), refusals))
+            }
         })?;
         if !batch.is_empty() && batches.send(batch).is_err() {
             // The consumer is gone: nobody wants the messages any more.

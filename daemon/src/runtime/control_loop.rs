@@ -24,15 +24,17 @@
 //! Lockstep clock: one tick per received sample, no sleeping; the watchdog trips after
 //! `lockstep_timeout` of wall time without a sample.
 //!
-//! Samples pass a [`SampleGate`] first: one stamped in the future or older than the last is
-//! refused and counted, so the grid only ever follows time that has passed. A new adapter run
-//! (sequence numbers start over) or a link back from stale makes the controller set up its
-//! world and hold posture again from the next measurement ([`Controller::relink`]). A sample
-//! the controller cannot use (an undecodable flag, a joint outside its limits, NaN) faults it;
-//! until it has had one valid measurement there is no safe posture, and no command goes out
-//! (the adapter holds on its own). The status's fault text keeps the first cause of a fault
-//! and adds what followed ([`FaultLog`]); a second process publishing on `sensors` stops any
-//! walk and is reported there too.
+//! Samples come from the adapter pinned by iceoryx2 identity only (the ports refuse every other
+//! publisher's, [`super::trust`]) and pass a [`SampleGate`]: one stamped in the future or older
+//! than the last is refused and counted, so the grid only ever follows time that has passed. A
+//! new adapter run (a new publisher pinned once the one before is gone) or a link back from
+//! stale makes the controller set up its world and hold posture again from the next
+//! measurement ([`Controller::relink`]). A sample the controller cannot use (an undecodable
+//! flag, a joint outside its limits, NaN) faults it; until it has had one valid measurement
+//! there is no safe posture, and no command goes out (the adapter holds on its own). The
+//! status's fault text keeps the first cause of a fault and adds what followed ([`FaultLog`]);
+//! another process publishing on `sensors` stops any walk (hold) and no walk starts until it is
+//! gone.
 //!
 //! After each tick's command the tick's telemetry (estimate, set-points, support polygon, timing)
 //! goes out on `telemetry` for observers ([`super::telemetry`]); nothing is published between
@@ -55,6 +57,7 @@ use super::shared::{ControlOutcome, Shared, StartOutcome};
 use super::snapshot::SnapshotWriter;
 use super::stats::{LoopStats, MissRecord, log_histogram, record, summarize};
 use super::telemetry;
+use super::trust::AdapterFollower;
 use crate::controller::{
     Command, CommandMode, Controller, ControllerState, FaultCode, PreparedSequence,
 };
@@ -118,8 +121,10 @@ pub struct ControlLoop {
     stale_in_row: u32,
     sequence_id: u64,
     faults: FaultLog,
-    /// More than one process publishes on `sensors` (checked with each status).
-    second_adapter: bool,
+    /// Follows which adapter is pinned and who else publishes on `sensors`.
+    adapters: AdapterFollower,
+    /// Another process than the pinned adapter publishes on `sensors` (checked every round).
+    intruder: bool,
     last_state: ControllerState,
     /// The fault last recorded in `faults` (`None` outside a fault or controlled stop).
     last_fault: FaultCode,
@@ -162,7 +167,8 @@ impl ControlLoop {
             stale_in_row: 0,
             sequence_id: 0,
             faults: FaultLog::new(),
-            second_adapter: false,
+            adapters: AdapterFollower::new(),
+            intruder: false,
             last_state: ControllerState::Idle,
             last_fault: FaultCode::None,
             release_later: None,
@@ -365,14 +371,17 @@ impl ControlLoop {
         }
     }
 
-    /// Takes the newest sample into `self.sample` if one arrived and the gate accepts it; a
-    /// new adapter run makes the controller set up again from it.
+    /// Takes the pinned adapter's newest sample into `self.sample` if one arrived and the gate
+    /// accepts it; a new adapter run makes the controller set up again from it.
     fn take_sample(&mut self) -> Result<bool, ShmError> {
-        if !self.ports.take_latest_sample(&mut self.incoming)? {
+        let fresh = self.ports.take_latest_sample(&mut self.incoming)?;
+        let pin = self.ports.sensor_pin();
+        self.gate.count_foreign(&pin);
+        if !fresh {
             return Ok(false);
         }
         let taken = monotonic_ns();
-        match self.gate.judge(&self.incoming, taken) {
+        match self.gate.judge(&self.incoming, pin.pinned(), taken) {
             Verdict::Reject => return Ok(false),
             Verdict::Restarted => self.controller.relink(),
             Verdict::Accept => {}
@@ -524,6 +533,9 @@ impl ControlLoop {
     /// service thread that this thread is alive.
     fn housekeeping(&mut self) {
         self.shared.beat(monotonic_ns());
+        if self.check_adapters() {
+            self.write_status(self.daemon_state());
+        }
         if let Some(sequence) = self.release_later.take() {
             self.release(sequence);
         }
@@ -537,7 +549,7 @@ impl ControlLoop {
             let outcome = if self.link != LinkState::Fresh {
                 self.release(submission.sequence);
                 StartOutcome::AdapterStale
-            } else if self.second_adapter {
+            } else if self.intruder {
                 self.release(submission.sequence);
                 StartOutcome::SecondAdapter
             } else {
@@ -615,22 +627,28 @@ impl ControlLoop {
         true
     }
 
-    /// Checks that only one process publishes sensor samples; a second one stops any walk and
-    /// is reported until it is gone.
-    fn check_adapters(&mut self) {
-        let publishers = self.ports.sensor_publishers();
-        if publishers > 1 && !self.second_adapter {
-            self.second_adapter = true;
-            self.faults.record(format_args!(
-                "{publishers} processes publish on sensors (publishers): only one adapter may; \
-                 stop the other one"
-            ));
-            if self.controller.status().state == ControllerState::Executing {
-                self.controller.hold();
+    /// Follows the pinned adapter (let go once it is gone) and whether another process
+    /// publishes on `sensors`: while one does, a walk is stopped with hold and none starts
+    /// (its samples never reach the controller). Returns whether that changed.
+    fn check_adapters(&mut self) -> bool {
+        let intruder = self
+            .adapters
+            .check(&self.ports, &self.shared.adapter, monotonic_ns());
+        let onset = intruder && !self.intruder;
+        if onset && self.controller.status().state == ControllerState::Executing {
+            self.controller.hold();
+            match self.ports.sensor_pin().last_refused() {
+                Some(from) => self.faults.record(format_args!(
+                    "walk stopped: publisher {from} also publishes on sensors"
+                )),
+                None => self
+                    .faults
+                    .record("walk stopped: another process publishes on sensors"),
             }
-        } else if publishers <= 1 {
-            self.second_adapter = false;
         }
+        let changed = intruder != self.intruder;
+        self.intruder = intruder;
+        changed
     }
 
     fn daemon_state(&self) -> DaemonState {
@@ -646,7 +664,6 @@ impl ControlLoop {
 
     /// Writes a status snapshot for the service thread. No allocation.
     fn write_status(&mut self, state: DaemonState) {
-        self.check_adapters();
         let controller = self.controller.status();
         let status = &mut self.status;
         status.timestamp_ns = monotonic_ns();

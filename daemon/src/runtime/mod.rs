@@ -8,7 +8,12 @@
 //! - the **main thread** ([`service`]) serves sequence submissions and control requests, publishes
 //!   the status at `[runtime] status_rate_hz`, and talks to systemd.
 //!
-//! They share only lock-free slots and atomics ([`shared`], [`handoff`], [`snapshot`]).
+//! They share only lock-free slots and atomics ([`shared`], [`handoff`], [`snapshot`], and
+//! [`trust`]: the adapter walkd follows, pinned by its iceoryx2 identity).
+//!
+//! Monitoring cannot stop control: when `telemetry` or `status` has no free publisher slot (or
+//! `telemetry` cannot be opened), walkd starts and controls without it, and says so once in its
+//! log and in the status.
 //!
 //! Signals: SIGTERM / SIGINT → the controller holds, a final hold command and a final `stopping`
 //! status go out, services are released, exit 0.
@@ -28,6 +33,7 @@ mod shared;
 mod snapshot;
 mod stats;
 mod telemetry;
+mod trust;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -191,6 +197,12 @@ fn run(args: &DaemonArgs) -> Result<(), Failure> {
             "removed stale iceoryx2 resources of dead processes (e.g. a killed walkd)"
         );
     }
+    if let Some(error) = ports.status_off() {
+        tracing::warn!(
+            "status publication off: {error}; walkd controls without it (clients ask for the \
+             status instead)"
+        );
+    }
     let shared = Arc::new(Shared::new());
     let (status_out, status_in) = snapshot::snapshot(DaemonStatus::INITIAL);
     let timing = LoopTiming {
@@ -201,8 +213,13 @@ fn run(args: &DaemonArgs) -> Result<(), Failure> {
         status_interval_ns: (1e9 / runtime.status_rate_hz) as u64,
         spin_ns: u64::from(runtime.spin_us) * 1000,
     };
-    let control_thread =
+    let (control_thread, telemetry_off) =
         spawn_control_thread(&names, &runtime, controller, &shared, status_out, timing)?;
+    if let Some(error) = &telemetry_off {
+        tracing::warn!(
+            "telemetry off: {error}; walkd controls without it (observers get no telemetry)"
+        );
+    }
     let mut service = ServiceLoop::new(
         ports,
         Arc::clone(&shared),
@@ -217,6 +234,7 @@ fn run(args: &DaemonArgs) -> Result<(), Failure> {
             },
         },
         runtime.status_rate_hz,
+        telemetry_off.is_some(),
     );
     let _ = sd_notify::notify(&[sd_notify::NotifyState::Ready]);
     tracing::info!(
@@ -289,7 +307,11 @@ fn log_timing(stats: &stats::LoopStats) {
     }
 }
 
-/// Starts the control thread; returns once its ports are open (or failed to open).
+/// The control thread, as [`spawn_control_thread`] started it.
+type ControlThread = std::thread::JoinHandle<Result<stats::LoopStats, shm_types::ShmError>>;
+
+/// Starts the control thread; returns once its ports are open (or failed to open), with why it
+/// publishes no telemetry (if it does not).
 fn spawn_control_thread(
     names: &ServiceNames,
     runtime: &RuntimeConfig,
@@ -297,7 +319,7 @@ fn spawn_control_thread(
     shared: &Arc<Shared>,
     status_out: snapshot::SnapshotWriter<DaemonStatus>,
     mut timing: LoopTiming,
-) -> Result<std::thread::JoinHandle<Result<stats::LoopStats, shm_types::ShmError>>, Failure> {
+) -> Result<(ControlThread, Option<String>), Failure> {
     let (ready_tx, ready_rx) = std::sync::mpsc::channel();
     let names = names.clone();
     let shared = Arc::clone(shared);
@@ -321,7 +343,7 @@ fn spawn_control_thread(
             }
             let ports = match DaemonLoopPorts::open(&names, "walkd-control") {
                 Ok(ports) => {
-                    let _ = ready_tx.send(Ok(()));
+                    let _ = ready_tx.send(Ok(ports.telemetry_off().map(ToString::to_string)));
                     ports
                 }
                 Err(error) => {
@@ -333,7 +355,7 @@ fn spawn_control_thread(
         })
         .map_err(|e| fail(exit_code::FAILURE)(e.into()))?;
     match ready_rx.recv() {
-        Ok(Ok(())) => Ok(thread),
+        Ok(Ok(telemetry_off)) => Ok((thread, telemetry_off)),
         Ok(Err(error)) => Err(fail(exit_code::IPC)(error.into())),
         Err(_) => Err(fail(exit_code::FAILURE)(anyhow::anyhow!(
             "the control thread died at start"

@@ -7,6 +7,11 @@
 //! max_submission_bytes`, then whether a walk is executing ("busy" needs no parsing), then its
 //! stance count against `max_stances` (counted without building the stances). Memory freed
 //! after a walk or a refused submission is handed back to the operating system.
+//!
+//! The service thread also lists the publishers on `sensors` for the control thread
+//! ([`AdapterWatch`]), and puts the standing conditions hold and abort do not clear in front of
+//! the status's fault text ([`Notices`]): another process publishing on `sensors`, telemetry or
+//! status publication off.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -20,6 +25,7 @@ use shm_types::{
 use super::realtime::release_free_memory;
 use super::shared::{ControlOutcome, Shared, StartOutcome, Submission};
 use super::snapshot::SnapshotReader;
+use super::trust::AdapterWatch;
 use crate::controller::{Controller, ControllerConfig, GaitConfig};
 
 /// What a submitted sequence is checked and prepared against: the robot and its config.
@@ -49,6 +55,8 @@ pub struct SubmissionLimits {
 const HANDOFF_TIMEOUT: Duration = Duration::from_secs(2);
 /// Poll interval of the service loop.
 const POLL: Duration = Duration::from_millis(1);
+/// How often the publishers on `sensors` are listed for the control thread.
+const REVIEW_EVERY: Duration = Duration::from_millis(5);
 
 /// The service thread's state.
 pub struct ServiceLoop {
@@ -66,25 +74,64 @@ struct Requests {
     shared: Arc<Shared>,
     status_in: SnapshotReader<DaemonStatus>,
     acceptance: Acceptance,
+    notices: Notices,
     next_sequence_id: u64,
     next_ticket: u64,
 }
 
+/// The standing conditions the status names in front of its fault text: hold and abort do not
+/// clear them, only their end does.
+struct Notices {
+    /// Who publishes on `sensors` (an intruder is named while it is there).
+    adapters: AdapterWatch,
+    /// walkd found no free `telemetry` publisher slot (or could not open the service).
+    telemetry_off: bool,
+    /// walkd found no free `status` publisher slot: the status is only had by asking.
+    status_off: bool,
+}
+
+impl Notices {
+    /// Puts the conditions in front of `status`'s fault text (cut at its capacity).
+    fn apply(&self, status: &mut DaemonStatus) {
+        let mut parts: Vec<String> = self.adapters.notice().into_iter().collect();
+        if self.telemetry_off {
+            parts.push("telemetry off (see walkd's log)".to_owned());
+        }
+        if self.status_off {
+            parts.push("status publication off (see walkd's log)".to_owned());
+        }
+        if parts.is_empty() {
+            return;
+        }
+        if !status.fault.is_empty() {
+            parts.push(status.fault.as_str().to_owned());
+        }
+        status.fault = FixedText::new(&parts.join("; "));
+    }
+}
+
 impl ServiceLoop {
-    /// Sets up the service side.
+    /// Sets up the service side; `telemetry_off`: the control thread publishes no telemetry.
     pub fn new(
         ports: DaemonServicePorts,
         shared: Arc<Shared>,
         status_in: SnapshotReader<DaemonStatus>,
         acceptance: Acceptance,
         status_rate_hz: f64,
+        telemetry_off: bool,
     ) -> Self {
+        let status_off = ports.status_off().is_some();
         Self {
             ports,
             requests: Requests {
                 shared,
                 status_in,
                 acceptance,
+                notices: Notices {
+                    adapters: AdapterWatch::new(),
+                    telemetry_off,
+                    status_off,
+                },
                 next_sequence_id: 1,
                 next_ticket: 1,
             },
@@ -98,8 +145,17 @@ impl ServiceLoop {
     /// Serves until `keep_running()` turns false.
     pub fn run(&mut self, keep_running: impl Fn() -> bool) -> Result<(), ShmError> {
         let mut next_status = Instant::now();
+        let mut next_review = Instant::now();
         while keep_running() {
             let requests = &mut self.requests;
+            if Instant::now() >= next_review {
+                next_review = Instant::now() + REVIEW_EVERY;
+                let link_stale = requests.status_in.read().link == LinkState::Stale;
+                requests
+                    .notices
+                    .adapters
+                    .review(&self.ports, &requests.shared.adapter, link_stale);
+            }
             if let Some(finished) = requests.shared.outbox.take() {
                 drop(finished);
                 release_free_memory();
@@ -126,7 +182,7 @@ impl ServiceLoop {
 
     /// Publishes the newest status and keeps systemd informed.
     pub fn publish_status(&mut self) -> Result<(), ShmError> {
-        let mut status = self.requests.status_in.read();
+        let mut status = self.requests.status();
         if status.timestamp_ns == 0 {
             // Before the control loop's first status: stamped now, not at the clock's origin
             // (an observer files messages by their time stamps).
@@ -176,6 +232,14 @@ impl ServiceLoop {
 }
 
 impl Requests {
+    /// The newest status the control thread wrote, with the standing conditions in front of its
+    /// fault text.
+    fn status(&mut self) -> DaemonStatus {
+        let mut status = self.status_in.read();
+        self.notices.apply(&mut status);
+        status
+    }
+
     /// Validates, prepares and hands over a submitted sequence; the reply says why not.
     fn handle_submission(&mut self, json: &[u8]) -> SubmitReply {
         match self.try_submit(json) {
@@ -263,11 +327,12 @@ impl Requests {
                         "no fresh sensor samples from the adapter: the sequence cannot start"
                             .to_owned(),
                     ),
-                    StartOutcome::SecondAdapter => Err(
-                        "more than one process publishes on sensors: stop the other adapter \
-                         first"
+                    StartOutcome::SecondAdapter => Err(match self.notices.adapters.notice() {
+                        Some(notice) => format!("{notice}: stop it first"),
+                        None => "another process published on sensors just now: retry once it \
+                                 is gone"
                             .to_owned(),
-                    ),
+                    }),
                 };
             }
             if start.elapsed() > HANDOFF_TIMEOUT && self.shared.inbox.take().is_some() {
@@ -283,7 +348,7 @@ impl Requests {
         let mut reply = ControlReply {
             accepted: Flag::YES,
             message: FixedText::EMPTY,
-            status: self.status_in.read(),
+            status: self.status(),
         };
         let command = match command {
             Ok(command) => command,
@@ -325,7 +390,7 @@ impl Requests {
                 ));
             }
         }
-        reply.status = self.status_in.read();
+        reply.status = self.status();
         reply
     }
 }

@@ -5,6 +5,7 @@ use std::sync::atomic::{AtomicBool, AtomicU8, AtomicU64, Ordering};
 use shm_types::ControlCommand;
 
 use super::handoff::Slot;
+use super::trust::AdapterTrust;
 use crate::controller::{PreparedSequence, ResetRefusal, StartRefusal};
 
 /// A prepared sequence on its way to the control thread.
@@ -27,7 +28,7 @@ pub enum StartOutcome {
     Refused(StartRefusal),
     /// No fresh samples from the adapter: nothing could execute it.
     AdapterStale,
-    /// More than one process publishes sensor samples: none can be trusted.
+    /// Another process than the adapter walkd follows publishes on `sensors`.
     SecondAdapter,
 }
 
@@ -114,6 +115,8 @@ pub struct Shared {
     /// Control → service thread: when the control loop last went round (CLOCK_MONOTONIC ns),
     /// so systemd's watchdog is fed only while the control thread is alive.
     heartbeat_ns: AtomicU64,
+    /// Both ways: the adapter walkd follows, and who else publishes on `sensors`.
+    pub adapter: AdapterTrust,
 }
 
 impl Shared {
@@ -128,6 +131,7 @@ impl Shared {
             control_outcome: AtomicU8::new(0),
             stop: AtomicBool::new(false),
             heartbeat_ns: AtomicU64::new(shm_types::monotonic_ns()),
+            adapter: AdapterTrust::new(),
         }
     }
 

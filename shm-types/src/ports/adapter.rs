@@ -3,14 +3,22 @@
 use core::time::Duration;
 
 use super::stream::{StreamReceiver, StreamSender};
+use super::trust::Refusals;
 use crate::services::{self, IpcNode};
 use crate::{JointCommand, SensorSample, ServiceNames, ShmError};
 
-/// Sensor samples out, joint commands in. All operations are allocation-free after `open`.
+/// Sensor samples out, joint commands in. Taking commands allocates nothing after `open` while
+/// only the pinned daemon sends them (see below); each sample published is loaned from
+/// iceoryx2, whose 0.10 loan allocates one small block.
 ///
 /// A typical adapter loop: fill and [`publish_sample`](Self::publish_sample) every period;
 /// [`take_latest_command`](Self::take_latest_command) before applying the next command; hold
 /// position when no fresh command came for a few periods.
+///
+/// Commands are taken only from the daemon's publisher pinned on the first command; the others
+/// are refused and counted ([`command_refusals`](Self::command_refusals)). While refused
+/// commands come, the ports list the publishers of `commands` at most every 50 ms, and follow
+/// the next daemon once the pinned one is gone (it left, or its process died).
 pub struct AdapterPorts {
     sensors: StreamSender<SensorSample>,
     commands: StreamReceiver<JointCommand>,
@@ -24,7 +32,7 @@ impl AdapterPorts {
         let (node, _) = services::create_node(node_name)?;
         Ok(Self {
             sensors: StreamSender::open(&node, names)?,
-            commands: StreamReceiver::open(&node, names)?,
+            commands: StreamReceiver::open(&node, names, true)?,
             _node: node,
         })
     }
@@ -43,8 +51,14 @@ impl AdapterPorts {
         self.commands.wait(timeout)
     }
 
-    /// Copies the newest command into `out`; false when none arrived since the last call.
+    /// Copies the newest command of the pinned daemon into `out`; false when none arrived since
+    /// the last call.
     pub fn take_latest_command(&self, out: &mut JointCommand) -> Result<bool, ShmError> {
-        self.commands.take_latest(out)
+        Ok(self.commands.take_latest(out)?.any())
+    }
+
+    /// Commands refused because another publisher than the pinned daemon sent them.
+    pub fn command_refusals(&self) -> Refusals {
+        self.commands.trusted().refusals()
     }
 }

@@ -12,16 +12,19 @@ use iceoryx2::port::client::Client;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::client::ClientCreateError;
 
-use super::topic::TopicReceiver;
-use crate::services::{
-    self, Access, ControlService, IpcNode, PubSub, SubmitService, Topic, capacity,
-};
+use super::trust::TrustedReceiver;
+use crate::services::{self, Access, ControlService, IpcNode, SubmitService, Topic, capacity};
 use crate::{
     ControlCommand, ControlReply, ControlRequest, DaemonStatus, ServiceNames, ShmError, SubmitReply,
 };
 
 /// How often a waiting client looks for an answer.
 const POLL: Duration = Duration::from_millis(1);
+
+/// How long a client waits for a published status before it asks walkd for it instead (walkd
+/// publishes none when every publisher slot of `status` is taken): five periods of the default
+/// `[runtime] status_rate_hz` (20).
+const UNPUBLISHED_STATUS_WAIT: Duration = Duration::from_millis(250);
 
 type StancesClient = Client<ipc::Service, [u8], (), SubmitReply, ()>;
 type ControlClient = Client<ipc::Service, ControlRequest, (), ControlReply, ()>;
@@ -30,13 +33,12 @@ type ControlClient = Client<ipc::Service, ControlRequest, (), ControlReply, ()>;
 /// [`connect`](Self::connect) fails with [`ShmError::NotRunning`].
 pub struct ClientPorts {
     names: ServiceNames,
-    status: OnceCell<TopicReceiver<DaemonStatus>>,
+    status: OnceCell<TrustedReceiver<DaemonStatus>>,
     stances: OnceCell<StancesClient>,
     control: OnceCell<ControlClient>,
-    status_service: PubSub<DaemonStatus>,
     stances_service: SubmitService,
     control_service: ControlService,
-    _node: IpcNode,
+    node: IpcNode,
 }
 
 impl ClientPorts {
@@ -44,31 +46,36 @@ impl ClientPorts {
     /// subscribes to the status right away if it can (so the newest one is delivered soon).
     pub fn connect(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, _) = services::create_node(node_name)?;
+        // Only a daemon creates the status service: without one this fails at once.
+        services::publish_subscribe::<DaemonStatus>(&node, names, Access::OpenOnly)?;
         let ports = Self {
             names: names.clone(),
-            status_service: services::publish_subscribe(&node, names, Access::OpenOnly)?,
             stances_service: services::stances(&node, names, Access::OpenOnly)?,
             control_service: services::control(&node, names, Access::OpenOnly)?,
             status: OnceCell::new(),
             stances: OnceCell::new(),
             control: OnceCell::new(),
-            _node: node,
+            node,
         };
         // A full status service is reported when the status is asked for, not here.
         let _ = ports.status_subscriber();
         Ok(ports)
     }
 
-    /// Whether a live daemon serves these services (a status publisher and a stances server
-    /// exist). A `kill -9`ed daemon's ports are cleaned by `connect`, so they don't count.
+    /// Whether a live daemon serves these services (a stances and a control server exist; the
+    /// status publisher may be missing: monitoring cannot stop walkd). A `kill -9`ed daemon's
+    /// ports are cleaned by `connect`, so they don't count.
     pub fn daemon_present(&self) -> bool {
-        self.status_service.dynamic_config().number_of_publishers() > 0
-            && self.stances_service.dynamic_config().number_of_servers() > 0
+        self.stances_service.dynamic_config().number_of_servers() > 0
+            && self.control_service.dynamic_config().number_of_servers() > 0
     }
 
-    fn status_subscriber(&self) -> Result<&TopicReceiver<DaemonStatus>, ShmError> {
+    /// The status subscriber: it takes the statuses of the first publisher heard (walkd's) and
+    /// refuses any other's.
+    fn status_subscriber(&self) -> Result<&TrustedReceiver<DaemonStatus>, ShmError> {
         created(&self.status, || {
-            TopicReceiver::subscribe(&self.names, &self.status_service, DaemonStatus::BUFFER)
+            let service = services::publish_subscribe(&self.node, &self.names, Access::OpenOnly)?;
+            TrustedReceiver::subscribe(&self.names, service, DaemonStatus::BUFFER, true)
         })
     }
 
@@ -97,16 +104,30 @@ impl ClientPorts {
     pub fn latest_status(&self) -> Result<Option<DaemonStatus>, ShmError> {
         let subscriber = self.status_subscriber()?;
         let mut status = DaemonStatus::INITIAL;
-        if !subscriber.take_latest(&mut status)? {
+        if !subscriber.take_latest(&mut status)?.any() {
             return Ok(None);
         }
         checked_status(subscriber.name(), status).map(Some)
     }
 
-    /// Waits up to `timeout` for a status newer than the last one received.
+    /// Waits up to `timeout` for a status newer than the last one received. When none is
+    /// published for 250 ms (walkd found no free publisher slot on `status`), asks walkd for it
+    /// instead.
     pub fn next_status(&self, timeout: Duration) -> Result<DaemonStatus, ShmError> {
         let service = self.names.full("status");
-        poll_until(&service, timeout, || self.latest_status())
+        let mut ask_at = std::time::Instant::now() + UNPUBLISHED_STATUS_WAIT;
+        poll_until(&service, timeout, || {
+            if std::time::Instant::now() < ask_at {
+                return self.latest_status();
+            }
+            ask_at = std::time::Instant::now() + UNPUBLISHED_STATUS_WAIT;
+            match self.control(ControlCommand::Query, timeout) {
+                Ok(reply) => Ok(Some(reply.status)),
+                // Every control slot taken: the published status is all there is.
+                Err(ShmError::ServiceFull { .. }) => self.latest_status(),
+                Err(other) => Err(other),
+            }
+        })
     }
 
     /// Submits a post-processed sequence (its JSON) and waits up to `timeout` for the verdict.

@@ -11,37 +11,53 @@ use iceoryx2::prelude::*;
 
 use super::stream::{StreamReceiver, StreamSender};
 use super::topic::TopicSender;
-use crate::services::{self, Access, ControlService, IpcNode, SubmitService};
+use super::trust::{self, Pin, PublisherId, Roster};
+use crate::services::{self, Access, ControlService, IpcNode, PubSub, SubmitService};
 use crate::{
     ControlCommand, ControlReply, ControlRequest, DaemonStatus, DecodeError, JointCommand,
     SensorSample, ServiceNames, ShmError, SubmitReply, Telemetry,
 };
 
-/// The control thread's ports: sensor samples in, joint commands and telemetry out. All
-/// operations are allocation-free after `open`.
+/// The control thread's ports: sensor samples in, joint commands and telemetry out. Taking
+/// samples allocates nothing after `open`; each message sent is loaned from iceoryx2, whose
+/// 0.10 loan allocates one small block (`tests/pinned_samples_allocation.rs` counts the take).
+///
+/// Samples are taken only from the adapter's publisher pinned on the first sample; the others
+/// are refused and counted ([`Pin`]). Telemetry is for observers only: when its service cannot
+/// be opened or has no free publisher slot, the ports open without it and say why
+/// ([`telemetry_off`](Self::telemetry_off)).
 pub struct DaemonLoopPorts {
     sensors: StreamReceiver<SensorSample>,
     commands: StreamSender<JointCommand>,
-    telemetry: TopicSender<Telemetry>,
+    telemetry: Result<TopicSender<Telemetry>, ShmError>,
     _node: IpcNode,
 }
 
 impl DaemonLoopPorts {
-    /// Opens (or creates) `sensors`, `commands` and `telemetry` under `names`.
+    /// Opens (or creates) `sensors` and `commands` under `names`, and `telemetry` if it can.
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, _) = services::create_node(node_name)?;
         Ok(Self {
-            sensors: StreamReceiver::open(&node, names)?,
+            sensors: StreamReceiver::open(&node, names, false)?,
             commands: StreamSender::open(&node, names)?,
-            telemetry: TopicSender::open(&node, names, 1)?,
+            telemetry: TopicSender::open(&node, names, 1),
             _node: node,
         })
     }
 
+    /// Why there is no telemetry (its service could not be opened, or every publisher slot of it
+    /// is taken); `None` while it is published.
+    pub fn telemetry_off(&self) -> Option<&ShmError> {
+        self.telemetry.as_ref().err()
+    }
+
     /// Writes one tick's telemetry in place and publishes it to the observers (no wake-up, no
-    /// system call). Call it after the tick's command was sent.
+    /// system call); nothing without telemetry. Call it after the tick's command was sent.
     pub fn publish_telemetry(&self, fill: impl FnOnce(&mut Telemetry)) -> Result<(), ShmError> {
-        self.telemetry.send(fill)
+        match &self.telemetry {
+            Ok(telemetry) => telemetry.send(fill),
+            Err(_) => Ok(()),
+        }
     }
 
     /// Blocks until the adapter announces a sample or `timeout` passes.
@@ -49,15 +65,22 @@ impl DaemonLoopPorts {
         self.sensors.wait(timeout)
     }
 
-    /// Copies the newest sample into `out`; false when none arrived since the last call.
+    /// Copies the newest sample of the pinned adapter into `out` (pinning the publisher of the
+    /// first sample); false when none arrived since the last call. Samples of other publishers
+    /// are refused and counted in [`sensor_pin`](Self::sensor_pin).
     pub fn take_latest_sample(&self, out: &mut SensorSample) -> Result<bool, ShmError> {
-        self.sensors.take_latest(out)
+        Ok(self.sensors.take_latest(out)?.any())
     }
 
-    /// How many processes publish on `sensors` (more than one: two adapters' samples would
-    /// interleave). Reads a counter in shared memory; no allocation.
-    pub fn sensor_publishers(&self) -> usize {
-        self.sensors.publishers()
+    /// Which publisher on `sensors` is trusted, and what the others sent.
+    pub fn sensor_pin(&self) -> Pin {
+        self.sensors.trusted().pin()
+    }
+
+    /// The pinned adapter `publisher` is gone (another thread reviewed `sensors`,
+    /// [`DaemonServicePorts::review_sensors`]): the next publisher heard is pinned.
+    pub fn release_sensor_pin(&self, publisher: PublisherId) {
+        self.sensors.trusted().release(publisher);
     }
 
     /// Writes a command in place, stamps its send time and wakes the adapter.
@@ -69,24 +92,32 @@ impl DaemonLoopPorts {
     }
 }
 
-/// The service thread's ports: status out, sequence submissions and control requests in.
+/// The service thread's ports: status out, sequence submissions and control requests in, and
+/// the roster of `sensors`.
+///
+/// The status is for monitoring: when its service has no free publisher slot, the ports open
+/// without it and say why ([`status_off`](Self::status_off)); clients then get the status with
+/// their control queries.
 pub struct DaemonServicePorts {
     stances_name: String,
     control_name: String,
-    status: TopicSender<DaemonStatus>,
+    status: Result<TopicSender<DaemonStatus>, ShmError>,
     stances: Server<ipc::Service, [u8], (), SubmitReply, ()>,
     control: Server<ipc::Service, ControlRequest, (), ControlReply, ()>,
+    sensors: PubSub<SensorSample>,
     _services: (SubmitService, ControlService),
     _node: IpcNode,
     cleaned_dead_nodes: u64,
 }
 
 impl DaemonServicePorts {
-    /// Opens (or creates) `status`, `stances` and `control` under `names`.
+    /// Opens (or creates) `stances`, `control` and `sensors` under `names`, and publishes on
+    /// `status` if it can.
     pub fn open(names: &ServiceNames, node_name: &str) -> Result<Self, ShmError> {
         let (node, cleaned_dead_nodes) = services::create_node(node_name)?;
         let (stances_name, control_name) = (names.full("stances"), names.full("control"));
-        let status = TopicSender::open(&node, names, 2)?;
+        let status = TopicSender::open(&node, names, 2);
+        let sensors = services::publish_subscribe(&node, names, Access::OpenOrCreate)?;
         let stances_service = services::stances(&node, names, Access::OpenOrCreate)?;
         let control_service = services::control(&node, names, Access::OpenOrCreate)?;
         let stances = stances_service
@@ -103,6 +134,7 @@ impl DaemonServicePorts {
             status,
             stances,
             control,
+            sensors,
             _services: (stances_service, control_service),
             _node: node,
             cleaned_dead_nodes,
@@ -114,9 +146,24 @@ impl DaemonServicePorts {
         self.cleaned_dead_nodes
     }
 
-    /// Publishes a status snapshot.
+    /// Why the status is not published (no free publisher slot, or its service could not be
+    /// opened); `None` while it is.
+    pub fn status_off(&self) -> Option<&ShmError> {
+        self.status.as_ref().err()
+    }
+
+    /// Publishes a status snapshot (nothing while the status is off).
     pub fn publish_status(&self, status: &DaemonStatus) -> Result<(), ShmError> {
-        self.status.send_copy(status)
+        match &self.status {
+            Ok(sender) => sender.send_copy(status),
+            Err(_) => Ok(()),
+        }
+    }
+
+    /// The publishers on `sensors` now, and whether `pinned` (the control thread's adapter) is
+    /// gone; with `clean_dead`, dead processes' nodes are removed first. Allocates.
+    pub fn review_sensors(&self, pinned: Option<PublisherId>, clean_dead: bool) -> Roster {
+        trust::review(&self.sensors, pinned, clean_dead)
     }
 
     /// Answers at most one pending submission with `handle(json_bytes)`; returns whether there

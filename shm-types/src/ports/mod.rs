@@ -7,10 +7,12 @@ mod daemon;
 mod observer;
 mod stream;
 mod topic;
+mod trust;
 mod truth;
 
 pub use adapter::AdapterPorts;
 pub use client::ClientPorts;
 pub use daemon::{DaemonLoopPorts, DaemonServicePorts};
 pub use observer::{Observed, ObserverPorts};
+pub use trust::{Admission, Peer, Pin, PublisherId, Refusals, Roster, Taken};
 pub use truth::{TruthPublisher, TruthSubscriber};

@@ -7,8 +7,14 @@
 //! [`services::STREAM_OBSERVER_BUFFER`] stream messages and [`services::TELEMETRY_BUFFER`]
 //! telemetries, so an observer that drains every few milliseconds loses nothing at 1 kHz; one
 //! that falls further behind loses the oldest, visible as gaps in the messages' `seq`.
+//!
+//! Each stream is taken from one publisher only: the first one heard (walkd's telemetry,
+//! commands and status, the adapter's samples). Messages of any other publisher are refused and
+//! reported as [`Observed::Refused`], so an observer never records forged data.
 
-use super::topic::TopicReceiver;
+use core::cell::Cell;
+
+use super::trust::{Refusals, TrustedReceiver};
 use crate::services::{self, Access, IpcNode, Topic};
 use crate::{DaemonStatus, JointCommand, SensorSample, ServiceNames, ShmError, Telemetry};
 
@@ -23,15 +29,61 @@ pub enum Observed<'a> {
     Command(&'a JointCommand),
     /// A status walkd published.
     Status(&'a DaemonStatus),
+    /// Messages on `service` came from another publisher than the one pinned there, and were
+    /// refused (`refusals` counts all so far).
+    Refused {
+        /// The service's full name.
+        service: &'a str,
+        /// What was refused on it.
+        refusals: Refusals,
+    },
+}
+
+/// One stream of an observer: its trusted subscriber, and the refusals reported so far.
+struct Stream<T: Topic> {
+    receiver: TrustedReceiver<T>,
+    reported: Cell<u64>,
+}
+
+impl<T: Topic> Stream<T> {
+    fn new(receiver: TrustedReceiver<T>) -> Self {
+        Self {
+            receiver,
+            reported: Cell::new(0),
+        }
+    }
+
+    /// Passes the pinned publisher's messages as `wrap` makes them, then what was refused since
+    /// the last call; returns how many messages were passed.
+    fn drain(
+        &self,
+        each: &mut impl FnMut(Observed<'_>),
+        wrap: for<'m> fn(&'m T) -> Observed<'m>,
+    ) -> Result<usize, ShmError> {
+        let mut count = 0;
+        self.receiver.drain(|message| {
+            count += 1;
+            each(wrap(message));
+        })?;
+        let refusals = self.receiver.refusals();
+        if refusals.count > self.reported.get() {
+            self.reported.set(refusals.count);
+            each(Observed::Refused {
+                service: self.receiver.name(),
+                refusals,
+            });
+        }
+        Ok(count)
+    }
 }
 
 /// A running daemon's streams, seen by an observer. Only opens what a daemon created: if no
 /// daemon serves `names`, [`open`](Self::open) fails with [`ShmError::NotRunning`].
 pub struct ObserverPorts {
-    telemetry: TopicReceiver<Telemetry>,
-    sensors: TopicReceiver<SensorSample>,
-    commands: TopicReceiver<JointCommand>,
-    status: TopicReceiver<DaemonStatus>,
+    telemetry: Stream<Telemetry>,
+    sensors: Stream<SensorSample>,
+    commands: Stream<JointCommand>,
+    status: Stream<DaemonStatus>,
     _node: IpcNode,
 }
 
@@ -42,28 +94,31 @@ impl ObserverPorts {
         let (node, _) = services::create_node(node_name)?;
         // The status service is opened first and only opened: without a daemon this fails.
         let status = services::publish_subscribe(&node, names, Access::OpenOnly)?;
-        let status = TopicReceiver::subscribe(names, &status, DaemonStatus::BUFFER)?;
-        let telemetry = TopicReceiver::open(&node, names, Telemetry::BUFFER)?;
-        let sensors = TopicReceiver::open(&node, names, SensorSample::BUFFER)?;
-        let commands = TopicReceiver::open(&node, names, JointCommand::BUFFER)?;
+        let status = TrustedReceiver::subscribe(names, status, DaemonStatus::BUFFER, true)?;
+        let telemetry = TrustedReceiver::open(&node, names, Telemetry::BUFFER, true)?;
+        let sensors = TrustedReceiver::open(&node, names, SensorSample::BUFFER, true)?;
+        let commands = TrustedReceiver::open(&node, names, JointCommand::BUFFER, true)?;
         Ok(Self {
-            telemetry,
-            sensors,
-            commands,
-            status,
+            telemetry: Stream::new(telemetry),
+            sensors: Stream::new(sensors),
+            commands: Stream::new(commands),
+            status: Stream::new(status),
             _node: node,
         })
     }
 
     /// Passes every message received since the last call to `each`: telemetry first, then
-    /// sensor samples, commands and statuses, each oldest first. A tick's telemetry is published
-    /// after its sample and its command, so the sample and the command a drained telemetry
-    /// names are delivered in the same call (unless they were lost). Returns how many.
+    /// sensor samples, commands and statuses, each oldest first, each stream followed by what it
+    /// refused since the last call. A tick's telemetry is published after its sample and its
+    /// command, so the sample and the command a drained telemetry names are delivered in the same
+    /// call (unless they were lost). Returns how many messages were passed.
     pub fn drain(&self, mut each: impl FnMut(Observed<'_>)) -> Result<usize, ShmError> {
-        Ok(self.telemetry.drain(|t| each(Observed::Telemetry(t)))?
-            + self.sensors.drain(|s| each(Observed::Sample(s)))?
-            + self.commands.drain(|c| each(Observed::Command(c)))?
-            + self.status.drain(|s| each(Observed::Status(s)))?)
+        Ok(self
+            .telemetry
+            .drain(&mut each, |t| Observed::Telemetry(t))?
+            + self.sensors.drain(&mut each, |s| Observed::Sample(s))?
+            + self.commands.drain(&mut each, |c| Observed::Command(c))?
+            + self.status.drain(&mut each, |s| Observed::Status(s))?)
     }
 }
 

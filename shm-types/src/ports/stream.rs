@@ -1,6 +1,7 @@
 //! The two ends of a high-rate stream (`sensors`, `commands`): a publisher that wakes its
 //! listeners after every message, and a subscriber that waits for that wake-up and keeps only
-//! the newest message. Shared by the daemon and the adapter, which use it in opposite directions.
+//! the newest message of the one publisher it trusts. Shared by the daemon and the adapter,
+//! which use it in opposite directions.
 
 use core::time::Duration;
 
@@ -9,8 +10,9 @@ use iceoryx2::port::listener::ListenerWaitError;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 
-use super::topic::{TopicReceiver, TopicSender};
-use crate::services::{self, Access, IpcNode, PubSub, StreamPayload};
+use super::topic::TopicSender;
+use super::trust::{Taken, TrustedReceiver};
+use crate::services::{self, IpcNode, StreamPayload};
 use crate::{ServiceNames, ShmError};
 
 /// Sending end: publish + notify.
@@ -41,32 +43,33 @@ impl<T: StreamPayload> StreamSender<T> {
     }
 }
 
-/// Receiving end: wait for the wake-up, take the newest message.
+/// Receiving end: wait for the wake-up, take the newest message of the pinned publisher
+/// ([`TrustedReceiver`]).
 pub(crate) struct StreamReceiver<T: StreamPayload> {
-    receiver: TopicReceiver<T>,
+    receiver: TrustedReceiver<T>,
     listener: Listener<ipc::Service>,
-    service: PubSub<T>,
 }
 
 impl<T: StreamPayload> StreamReceiver<T> {
-    /// Opens (or creates) the stream of `T` under `names` and its event, as their receiver.
-    pub(crate) fn open(node: &IpcNode, names: &ServiceNames) -> Result<Self, ShmError> {
-        let service = services::publish_subscribe::<T>(node, names, Access::OpenOrCreate)?;
-        let receiver = TopicReceiver::subscribe(names, &service, services::STREAM_PEER_BUFFER)?;
+    /// Opens (or creates) the stream of `T` under `names` and its event, as their receiver;
+    /// `reviews_itself` as in [`TrustedReceiver`].
+    pub(crate) fn open(
+        node: &IpcNode,
+        names: &ServiceNames,
+        reviews_itself: bool,
+    ) -> Result<Self, ShmError> {
+        let receiver =
+            TrustedReceiver::open(node, names, services::STREAM_PEER_BUFFER, reviews_itself)?;
         let listener = services::stream_event::<T>(node, names)?
             .listener_builder()
             .create()
             .map_err(|e| ShmError::ipc("create listener on", receiver.name(), e))?;
-        Ok(Self {
-            receiver,
-            listener,
-            service,
-        })
+        Ok(Self { receiver, listener })
     }
 
-    /// How many publishers the stream has now.
-    pub(crate) fn publishers(&self) -> usize {
-        self.service.dynamic_config().number_of_publishers()
+    /// The receiving end: its pin, roster and publishers.
+    pub(crate) fn trusted(&self) -> &TrustedReceiver<T> {
+        &self.receiver
     }
 
     /// Blocks until a message is announced or `timeout` passes; returns whether one was
@@ -79,9 +82,9 @@ impl<T: StreamPayload> StreamReceiver<T> {
         }
     }
 
-    /// Copies the newest received message into `out`, dropping older ones; returns false when
-    /// nothing new arrived. No heap allocation.
-    pub(crate) fn take_latest(&self, out: &mut T) -> Result<bool, ShmError> {
+    /// Copies the newest message of the pinned publisher into `out`, dropping older ones and
+    /// refusing other publishers' messages. No heap allocation without reviews of its own.
+    pub(crate) fn take_latest(&self, out: &mut T) -> Result<Taken, ShmError> {
         self.receiver.take_latest(out)
     }
 }

@@ -4,10 +4,11 @@
 //! A port keeps its service alive (iceoryx2 ports share the service's state), so neither holds the
 //! port factory it was created from.
 
-use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::publisher::{Publisher, PublisherCreateError};
 use iceoryx2::port::subscriber::{Subscriber, SubscriberCreateError};
 use iceoryx2::prelude::*;
 
+use super::trust::PublisherId;
 use crate::services::{self, Access, IpcNode, PubSub, Topic};
 use crate::{ServiceNames, ShmError};
 
@@ -26,11 +27,19 @@ impl<T: Topic> TopicSender<T> {
         loans: usize,
     ) -> Result<Self, ShmError> {
         let name = names.full(T::KIND);
-        let publisher = services::publish_subscribe::<T>(node, names, Access::OpenOrCreate)?
+        let service = services::publish_subscribe::<T>(node, names, Access::OpenOrCreate)?;
+        let publisher = service
             .publisher_builder()
             .max_loaned_samples(loans)
             .create()
-            .map_err(|e| ShmError::ipc("create publisher on", &name, e))?;
+            .map_err(|e| match e {
+                PublisherCreateError::ExceedsMaxSupportedPublishers => ShmError::ServiceFull {
+                    service: name.clone(),
+                    port: "publisher",
+                    limit: service.static_config().max_publishers(),
+                },
+                other => ShmError::ipc("create publisher on", &name, other),
+            })?;
         Ok(Self { name, publisher })
     }
 
@@ -111,21 +120,25 @@ impl<T: Topic> TopicReceiver<T> {
     /// Passes every message received since the last call to `each`, oldest first; returns how
     /// many. No heap allocation.
     pub(crate) fn drain(&self, mut each: impl FnMut(&T)) -> Result<usize, ShmError> {
+        self.drain_from(|_, message| each(message))
+    }
+
+    /// Passes every message received since the last call to `each` with its publisher (the
+    /// connection it came through, not what the publisher wrote), oldest first per publisher;
+    /// returns how many. No heap allocation.
+    pub(crate) fn drain_from(
+        &self,
+        mut each: impl FnMut(PublisherId, &T),
+    ) -> Result<usize, ShmError> {
         let mut count = 0;
         while let Some(sample) = self
             .subscriber
             .receive()
             .map_err(|e| ShmError::ipc("receive from", &self.name, e))?
         {
-            each(sample.payload());
+            each(sample.origin().into(), sample.payload());
             count += 1;
         }
         Ok(count)
-    }
-
-    /// Copies the newest received message into `out`, dropping older ones; returns false when
-    /// nothing new arrived. No heap allocation.
-    pub(crate) fn take_latest(&self, out: &mut T) -> Result<bool, ShmError> {
-        Ok(self.drain(|message| *out = *message)? > 0)
     }
 }
