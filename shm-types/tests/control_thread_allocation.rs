@@ -1,5 +1,7 @@
-//! walkd's control thread takes samples through `DaemonLoopPorts`: pinning the adapter and
-//! refusing another publisher's samples there allocates nothing.
+//! What walkd's control thread allocates in `DaemonLoopPorts`: taking samples (pinning the
+//! adapter, refusing another publisher's samples) allocates nothing; each send (a command, a
+//! telemetry) allocates exactly one block inside iceoryx2 0.10 — its loan wraps the chunk's
+//! state in an `Rc` — and frees it before returning (docs/architecture.md).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -11,6 +13,8 @@ struct Counting;
 thread_local! {
     /// Allocations of this thread while counting (`None`: not counting).
     static ALLOCATIONS: Cell<Option<usize>> = const { Cell::new(None) };
+    /// Frees of this thread while counting.
+    static FREES: Cell<Option<usize>> = const { Cell::new(None) };
 }
 
 fn count() {
@@ -23,6 +27,7 @@ unsafe impl GlobalAlloc for Counting {
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        FREES.with(|count| count.set(count.get().map(|n| n + 1)));
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
@@ -74,4 +79,30 @@ fn taking_the_pinned_adapters_samples_and_refusing_others_allocates_nothing() {
     assert_eq!(counted, 0, "the control thread's take allocated");
     assert_eq!(taken, 198);
     assert_eq!(daemon.sensor_pin().refused(), 199);
+}
+
+#[test]
+fn each_send_allocates_one_block_inside_iceoryx2_and_frees_it() {
+    let prefix = format!("walk-test/shm-types/send-alloc/{}", std::process::id());
+    let names = ServiceNames::new(&prefix).unwrap();
+    let daemon = DaemonLoopPorts::open(&names, "daemon").unwrap();
+    let adapter = AdapterPorts::open(&names, "adapter").unwrap();
+    let mut command = shm_types::JointCommand::ZERO;
+    // Connections are set up on the first sends and receives.
+    for seq in 0..3 {
+        daemon.send_command(|c| c.seq = seq).unwrap();
+        daemon.publish_telemetry(|t| t.seq = seq).unwrap();
+        adapter.take_latest_command(&mut command).unwrap();
+    }
+    for seq in 3..100 {
+        FREES.with(|count| count.set(Some(0)));
+        let allocated = allocations(|| {
+            daemon.send_command(|c| c.seq = seq).unwrap();
+            daemon.publish_telemetry(|t| t.seq = seq).unwrap();
+        });
+        let freed = FREES.with(|count| count.replace(None)).unwrap();
+        assert_eq!(allocated, 2, "one block a send");
+        assert_eq!(freed, 2, "freed before the send returned");
+        adapter.take_latest_command(&mut command).unwrap();
+    }
 }
