@@ -20,7 +20,7 @@ use crate::{
 
 /// The control thread's ports: sensor samples in, joint commands and telemetry out. Taking
 /// samples allocates nothing after `open`; each message sent is loaned from iceoryx2, whose
-/// 0.10 loan allocates one small block (`tests/pinned_samples_allocation.rs` counts the take).
+/// 0.10 loan allocates one small block (`tests/control_thread_allocation.rs` counts both).
 ///
 /// Samples are taken only from the adapter's publisher pinned on the first sample; the others
 /// are refused and counted ([`Pin`]). Telemetry is for observers only: when its service cannot
