@@ -55,7 +55,7 @@ const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
 
 /// How far above its foothold's height a swing sole may be and still count as landed when no
 /// force-torque confirms it (m): the ground stops a foot commanded below it within this.
-pub(crate) const LANDING_HEIGHT_TOLERANCE_M: f64 = 0.015;
+const LANDING_HEIGHT_TOLERANCE_M: f64 = 0.015;
 
 /// What the dynamic gait reads besides the static machine's [`Feedback`] (estimated, world).
 pub(crate) struct Sensors<'a> {
