@@ -98,7 +98,7 @@ fn joint_commands() {
 #[test]
 fn daemon_statuses() {
     fuzz_message("DaemonStatus", |status: &DaemonStatus| {
-        let defined = status.state.raw() <= 5
+        let defined = status.state.raw() <= 6
             && status.clock.raw() <= 1
             && status.link.raw() <= 2
             && status.adapter_holding.raw() <= 1;
