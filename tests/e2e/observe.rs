@@ -142,13 +142,16 @@ fn a_recorded_walk_reads_back_with_the_official_mcap_reader() {
             "{stream}: {observed}"
         );
     }
-    // walkd misses no more deadlines with the observer attached. Deadline misses on this shared
-    // machine come from OS stalls that differ between any two runs (measured: 8–11 per 28 s
-    // walk, with or without an observer), so the comparison allows that run-to-run spread.
+    // walkd misses no more deadlines with the observer attached than OS stalls explain.
+    // Deadline misses on this shared machine come from stalls that differ between any two runs:
+    // 2026-12-02, the same binaries, one 28 s walk each, idle machine: 4, 17, 23, 34 without an
+    // observer and 9, 16, 18, 32 with one (the observer's CPU time was 0.57–0.73 s per 10 s
+    // either way). So the comparison allows twice the misses plus that spread; an observer that
+    // held walkd up would add hundreds.
     let without = unobserved["deadline_misses"].as_u64().unwrap();
     let with = observed["deadline_misses"].as_u64().unwrap();
     assert!(
-        with <= without + 3 + without / 2,
+        with <= 2 * without + 30,
         "{with} deadline misses with the observer, {without} without"
     );
     let _ = std::fs::remove_dir_all(&dir);
