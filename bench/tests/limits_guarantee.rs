@@ -1,7 +1,8 @@
-//! The joint-limit guarantee as a property: whatever the measurements (valid, out of limits,
-//! NaN, infinite, huge), adapter restarts onto another posture in between, and whatever the
-//! requests (start, hold, abort, reset), every command the controller writes is finite and
-//! inside the URDF limits, and before its first valid measurement it writes none.
+//! The joint-limit guarantee as a property: whatever the measurements (valid, knocked, out of
+//! limits, NaN, infinite, huge), adapter restarts onto another posture in between, and whatever the
+//! requests (start, hold, abort, reset), every command the controller writes is finite, inside
+//! the URDF limits and no faster than the URDF velocity limits (from the previous command, and in
+//! its feed-forward velocity), and before its first valid measurement it writes none.
 
 mod walk_support;
 
@@ -27,6 +28,9 @@ enum Event {
     /// The adapter restarts with the robot in another posture: its arms, torso and head moved
     /// (offsets in [-1, 1] of up to 0.3 rad), its legs standing.
     Restart { offsets: Vec<f64> },
+    /// A tick on the true measurement with one joint knocked by this much (rad), kept inside
+    /// its limits: a valid reading that jumped, which the command must not chase at any speed.
+    Knock { index: usize, by: f64 },
     /// A request of a client.
     Request(Request),
 }
@@ -83,6 +87,7 @@ fn event() -> impl Strategy<Value = Event> {
             value
         }),
         1 => proptest::collection::vec(-1.0..1.0f64, 40).prop_map(|offsets| Event::Restart { offsets }),
+        2 => (0..64usize, -0.3..0.3f64).prop_map(|(index, by)| Event::Knock { index, by }),
         2 => request.prop_map(Event::Request),
     ]
 }
@@ -107,6 +112,9 @@ struct Run {
     dt: f64,
     commanded_ever: bool,
     commands: usize,
+    /// The last command written to the same adapter (none after a restart onto another one or a
+    /// reset).
+    previous: Option<nalgebra::DVector<f64>>,
 }
 
 impl Run {
@@ -120,6 +128,7 @@ impl Run {
             dt: 0.005,
             commanded_ever: false,
             commands: 0,
+            previous: None,
             robot,
         }
     }
@@ -145,7 +154,20 @@ impl Run {
                     limit.upper
                 );
                 assert!(qd.is_finite(), "joint {j}: qd_des {qd}");
+                let speed = limit.velocity;
+                assert!(
+                    qd.abs() <= speed * (1.0 + 1e-9),
+                    "joint {j}: qd_des {qd} beyond {speed}"
+                );
+                if let Some(previous) = &self.previous {
+                    let moved = (q - previous[j]).abs();
+                    assert!(
+                        moved <= speed * self.dt * (1.0 + 1e-9),
+                        "joint {j}: q_des moved {moved} rad in one tick, beyond {speed} rad/s"
+                    );
+                }
             }
+            self.previous = Some(self.command.q_des.clone());
         }
         commanded
     }
@@ -202,8 +224,22 @@ impl Run {
                 };
                 self.tick(&measurement);
             }
+            Event::Knock { index, by } => {
+                let mut q = m.q.clone();
+                let j = index % q.len();
+                let limit = self.robot.model.joint_limits()[j];
+                q[j] = (q[j] + by).clamp(limit.lower, limit.upper);
+                let measurement = Measurement {
+                    q: q.as_slice(),
+                    qd: m.qd.as_slice(),
+                    wrenches: &m.wrenches,
+                    imu_orientation: Some(m.base_orientation),
+                };
+                self.tick(&measurement);
+            }
             Event::Restart { offsets } => {
                 self.controller.relink();
+                self.previous = None;
                 self.sim = KinematicSim::new(self.robot.clone(), posture(&self.robot, offsets))
                     .expect("a posture inside the limits");
             }
@@ -216,7 +252,10 @@ impl Run {
             Event::Request(Request::Hold) => self.controller.hold(),
             Event::Request(Request::Abort) => self.controller.abort(),
             Event::Request(Request::Reset) => {
+                // A reset after a tipping fault re-anchors the command on the measured posture
+                // (where the joints are, so no motion), wherever the last command was.
                 let _ = self.controller.reset();
+                self.previous = None;
             }
         }
     }

@@ -11,7 +11,8 @@
 //! 4. builds the QP (CoM x/y, end-effector, upright and posture tasks; contact, support polygon,
 //!    joint position and velocity constraints) and solves it with the chosen back-end;
 //! 5. integrates the joint command from the previous one, `q_des ← q_des + q̇·dt`, kept within
-//!    `command_lead_max_rad` of the measured angle and inside the joint limits; `qd_des = q̇`.
+//!    `command_lead_max_rad` of the measured angle, no faster than the URDF velocity limit and inside
+//!    the joint limits; `qd_des = q̇`.
 //!    Integrating from the command rather than from the measurement keeps the servo offset that
 //!    holds a loaded joint against gravity (a position-controlled joint commanded to where it
 //!    already is exerts no torque).
@@ -812,8 +813,10 @@ impl Controller {
     }
 
     /// Integrates `q_des ← q_des + q̇·dt` from the last command (`last_command`), within
-    /// `command_lead_max_rad` of the measured angle and inside the joint limits; non-finite →
-    /// fault and hold. Returns true (a command is written either way).
+    /// `command_lead_max_rad` of the measured angle, no faster than the joint's URDF velocity
+    /// limit (even when the lead bound drags the command after a measurement that jumped) and
+    /// inside the joint limits; non-finite → fault and hold. Returns true (a command is written
+    /// either way).
     fn write_track(&mut self, measurement: &Measurement, dt: f64, out: &mut Command) -> bool {
         let limits = self.robot.model.joint_limits();
         let qd = &self.solution[6..];
@@ -825,8 +828,10 @@ impl Controller {
         for (j, limit) in limits.iter().enumerate() {
             let measured = measurement.q[j];
             let previous = self.last_command[j];
+            let reach = limit.velocity * dt;
             let q = (previous + qd[j] * dt)
                 .clamp(measured - lead, measured + lead)
+                .clamp(previous - reach, previous + reach)
                 .clamp(limit.lower, limit.upper);
             out.q_des[j] = q;
             out.qd_des[j] = (q - previous) / dt;
