@@ -43,9 +43,9 @@ pub use clock::{current_thread_is_fifo, monotonic_ns, sleep_then_spin_until, sle
 pub use config::{ConfigError, RuntimeBound, RuntimeConfig, RuntimeOverrides, WATCHDOG_MAX_S};
 pub use error::ShmError;
 pub use messages::{
-    ClockMode, CommandMode, ControlCommand, ControlReply, ControlRequest, DaemonState,
-    DaemonStatus, FAULT_TEXT, HISTOGRAM_BUCKETS, JointCommand, LatencySummary, LinkState,
-    LogHistogram, SensorSample, SimTruth, SubmitReply, WRENCH_ORDER,
+    ActuatorLoad, ClockMode, CommandMode, ControlCommand, ControlReply, ControlRequest,
+    DaemonState, DaemonStatus, FAULT_TEXT, HISTOGRAM_BUCKETS, JOINT_GROUPS, JointCommand,
+    LatencySummary, LinkState, LogHistogram, SensorSample, SimTruth, SubmitReply, WRENCH_ORDER,
 };
 pub use wire::{Code, DecodeError, Flag};
 
@@ -54,8 +54,9 @@ pub use telemetry::{SUPPORT_VERTICES, Telemetry, WalkPhase};
 pub use text::FixedText;
 
 /// Version of the wire protocol; part of every message's `#[type_name]`. Version 2: enums and
-/// flags travel as checked integers ([`wire`]); version 3: the daemon state `controlled_stop`.
-pub const PROTOCOL_VERSION: u32 = 3;
+/// flags travel as checked integers ([`wire`]); version 3: the daemon state `controlled_stop`;
+/// version 4: the simulator's actuator load in [`SimTruth`].
+pub const PROTOCOL_VERSION: u32 = 4;
 
 /// Fixed joint capacity of the joint arrays; messages carry the used count explicitly.
 pub const MAX_JOINTS: usize = 64;

@@ -17,7 +17,7 @@ pub const WRENCH_ORDER: [&str; 4] = ["left_foot", "right_foot", "left_hand", "ri
 /// One sensor reading, adapter → daemon.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v3.SensorSample")]
+#[type_name("walk.v4.SensorSample")]
 pub struct SensorSample {
     /// Strictly increasing per adapter run.
     pub seq: u64,
@@ -53,7 +53,7 @@ wire_enum! {
 /// One joint command, daemon → adapter.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v3.JointCommand")]
+#[type_name("walk.v4.JointCommand")]
 pub struct JointCommand {
     /// Strictly increasing per daemon run.
     pub seq: u64,
@@ -196,7 +196,7 @@ wire_enum! {
 /// Percentiles of a latency distribution in microseconds.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("walk.v3.LatencySummary")]
+#[type_name("walk.v4.LatencySummary")]
 pub struct LatencySummary {
     /// Median.
     pub p50: f32,
@@ -213,7 +213,7 @@ pub const HISTOGRAM_BUCKETS: usize = 20;
 /// [2^b, 2^(b+1)) µs, the last bucket everything above.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("walk.v3.LogHistogram")]
+#[type_name("walk.v4.LogHistogram")]
 pub struct LogHistogram {
     /// Samples per bucket.
     pub counts: [u64; HISTOGRAM_BUCKETS],
@@ -229,7 +229,7 @@ impl LogHistogram {
 /// The daemon's state, published at a low rate (daemon → clients) and returned by `control`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v3.DaemonStatus")]
+#[type_name("walk.v4.DaemonStatus")]
 pub struct DaemonStatus {
     /// [`crate::PROTOCOL_VERSION`] of the daemon.
     pub protocol_version: u32,
@@ -384,7 +384,7 @@ pub const FAULT_TEXT: usize = 256;
 /// [`DaemonStatus`] (world frame, translation xyz + quaternion xyzw of the sole frames).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("walk.v3.SimTruth")]
+#[type_name("walk.v4.SimTruth")]
 pub struct SimTruth {
     /// Strictly increasing per simulator run (a gap means a subscriber missed messages).
     pub seq: u64,
@@ -405,6 +405,43 @@ pub struct SimTruth {
     pub tilt_rad: f64,
     /// Whether the simulator's fall rule fired at any time since the start (it stays set).
     pub fallen: Flag,
+    /// How hard the simulated motors have worked since the start (all zero from a simulator
+    /// without actuator dynamics).
+    pub actuators: ActuatorLoad,
+}
+
+/// Joint groups of [`ActuatorLoad`], in its arrays' order (`[robot.joint_groups]`).
+pub const JOINT_GROUPS: [&str; 4] = ["legs", "arms", "torso", "head"];
+
+/// The load of a simulated robot's motors since the simulator started, against the URDF's limits:
+/// whether a walk asked more of a motor than it has. Per joint group ([`JOINT_GROUPS`]) the peak
+/// of `|τ| / effort limit` (sustained: |τ| low-passed over 20 ms, see walk-sim's
+/// `mujoco::actuators`) and of `|q̇| / velocity limit` over the group's joints (0 for an empty
+/// group or joints without a limit).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, serde::Serialize)]
+#[type_name("walk.v4.ActuatorLoad")]
+pub struct ActuatorLoad {
+    /// Peak sustained torque as a fraction of the effort limit, per joint group.
+    pub peak_torque_fraction: [f64; 4],
+    /// Peak joint speed as a fraction of the velocity limit, per joint group.
+    pub peak_speed_fraction: [f64; 4],
+    /// The longest stretch one joint spent at its torque limit (s).
+    pub longest_at_torque_limit_s: f64,
+    /// That joint's model index ([`ActuatorLoad::NO_JOINT`]: none was at its limit).
+    pub longest_at_torque_limit_joint: u32,
+}
+
+impl ActuatorLoad {
+    /// `longest_at_torque_limit_joint` when no joint reached its limit.
+    pub const NO_JOINT: u32 = u32::MAX;
+    /// Nothing measured.
+    pub const ZERO: Self = Self {
+        peak_torque_fraction: [0.0; 4],
+        peak_speed_fraction: [0.0; 4],
+        longest_at_torque_limit_s: 0.0,
+        longest_at_torque_limit_joint: Self::NO_JOINT,
+    };
 }
 
 impl SimTruth {
@@ -419,6 +456,7 @@ impl SimTruth {
         base_height_m: 0.0,
         tilt_rad: 0.0,
         fallen: Flag::NO,
+        actuators: ActuatorLoad::ZERO,
     };
 }
 
@@ -431,7 +469,7 @@ impl Default for SimTruth {
 /// The daemon's answer to a submitted sequence.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v3.SubmitReply")]
+#[type_name("walk.v4.SubmitReply")]
 pub struct SubmitReply {
     /// Whether the sequence was validated, prepared and started.
     pub accepted: Flag,
@@ -482,7 +520,7 @@ wire_enum! {
 /// A control request (client → daemon).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v3.ControlRequest")]
+#[type_name("walk.v4.ControlRequest")]
 pub struct ControlRequest {
     /// The command.
     pub command: Code<ControlCommand>,
@@ -506,7 +544,7 @@ impl Default for ControlRequest {
 /// The daemon's answer to a control request.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
-#[type_name("walk.v3.ControlReply")]
+#[type_name("walk.v4.ControlReply")]
 pub struct ControlReply {
     /// Whether the command was carried out.
     pub accepted: Flag,
