@@ -2,9 +2,9 @@
 //! daemon's setpoints its commands, and its true state the `sim-truth` record. One wrapper for the
 //! kinematic simulator and MuJoCo alike.
 
-use kinematic_sim::{SimMeasurement, Simulator};
+use kinematic_sim::{KinematicSim, SimMeasurement, Simulator};
 use kinematics::robot::EndEffector;
-use shm_types::{SensorSample, SimTruth};
+use shm_types::{ActuatorLoad, SensorSample, SimTruth};
 
 use crate::RobotIo;
 use crate::truth::{GroundTruth, pose_array, tilt};
@@ -43,10 +43,22 @@ impl<S: Simulator> RobotIo for SimulatedRobot<S> {
     }
 }
 
-impl<S: Simulator> GroundTruth for SimulatedRobot<S> {
+/// A simulator's account of how hard its motors work, for the `sim-truth` record: MuJoCo's
+/// torques and speeds against the URDF's limits. A simulator without actuator dynamics (the
+/// kinematic one) reports nothing.
+pub trait MotorLoad {
+    /// The load since the start.
+    fn actuator_load(&self) -> ActuatorLoad {
+        ActuatorLoad::ZERO
+    }
+}
+
+impl MotorLoad for KinematicSim {}
+
+impl<S: Simulator + MotorLoad> GroundTruth for SimulatedRobot<S> {
     /// The simulated state's CoM, soles and `base_link`; fallen = the simulator's fall rule fired
     /// at any step so far ([`kinematic_sim::SafetySummary::fell`]: the CoM left the support
-    /// polygon in the kinematic simulator; base too low or tilted under MuJoCo).
+    /// polygon in the kinematic simulator; base too low or tilted under MuJoCo); the motors' load.
     fn ground_truth(&mut self, out: &mut SimTruth) {
         let sim = &self.sim;
         let base_link = sim.base_link_pose();
@@ -56,6 +68,7 @@ impl<S: Simulator> GroundTruth for SimulatedRobot<S> {
         out.base_height_m = base_link.translation.z;
         out.tilt_rad = tilt(&base_link);
         out.fallen = sim.summary().fell.into();
+        out.actuators = sim.actuator_load();
     }
 }
 

@@ -37,7 +37,7 @@ use shm_types::{
     current_thread_is_fifo,
 };
 use sim_adapter::inject::{FaultInjector, FaultPlan};
-use sim_adapter::{AdapterOptions, PublishTruth, SimulatedRobot, run_adapter};
+use sim_adapter::{AdapterOptions, MotorLoad, PublishTruth, SimulatedRobot, run_adapter};
 
 /// Simulated robot for walkd: publishes sensor samples, applies joint commands.
 #[derive(Parser)]
@@ -249,7 +249,7 @@ fn serve_mujoco(
 
 /// Runs the adapter loop for `sim` until terminated, publishing its ground truth with every
 /// sample (and injecting the fault of `--inject`); logs the simulator's safety summary.
-fn serve<S: Simulator>(
+fn serve<S: Simulator + MotorLoad>(
     runtime: &RuntimeConfig,
     args: &Args,
     sim: SimulatedRobot<S>,

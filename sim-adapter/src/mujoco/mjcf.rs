@@ -3,7 +3,9 @@
 //! Generated from the URDF's kinematics and inertials (see `bodies`) rather than loaded with
 //! MuJoCo's URDF importer, so no mesh is needed and every modelling choice is explicit:
 //! - a free joint on the base and an infinite floor plane at z = 0;
-//! - one hinge/slide joint per actuated joint, with the URDF limits, armature and damping;
+//! - one hinge/slide joint per actuated joint, with the URDF position limits, armature and
+//!   damping, and the URDF effort limit as the bound on its actuators' torque (motor
+//!   saturation; a URDF effort of 0 or none leaves it unbounded);
 //! - collision geometry only where contact is meaningful: one box per foot, the configured sole
 //!   rectangle with its bottom face on the sole frame, colliding with the floor and nothing else;
 //! - sites at every end-effector frame, both FT frames and the base (the IMU);
@@ -250,10 +252,20 @@ fn write_body(
             } else {
                 String::new()
             };
+            // The motor's torque saturation: MuJoCo clamps the sum of the joint's actuators
+            // (the servo's position and velocity terms) to the URDF effort limit.
+            let effort = if limits.effort.is_finite() && limits.effort > 0.0 {
+                format!(
+                    r#" actuatorfrclimited="true" actuatorfrcrange="{} {}""#,
+                    -limits.effort, limits.effort
+                )
+            } else {
+                String::new()
+            };
             let a = joint.axis;
             let _ = writeln!(
                 xml,
-                r#"{pad}  <joint name="{}" type="{kind}" axis="{} {} {}"{range}/>"#,
+                r#"{pad}  <joint name="{}" type="{kind}" axis="{} {} {}"{range}{effort}/>"#,
                 escape(&joint.name),
                 a.x,
                 a.y,

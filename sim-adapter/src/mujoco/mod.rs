@@ -11,6 +11,7 @@
 //!
 //! [`SimMeasurement`]: kinematic_sim::SimMeasurement
 
+mod actuators;
 mod bodies;
 mod contact;
 mod error;
@@ -21,6 +22,7 @@ pub mod render;
 mod sim;
 mod visuals;
 
+pub use actuators::{AT_LIMIT_FRACTION, ActuatorRecord};
 pub use error::MujocoError;
 pub use options::MujocoOptions;
 pub use sim::MujocoSim;

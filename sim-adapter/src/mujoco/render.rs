@@ -162,6 +162,12 @@ impl PhotographedSim {
     }
 }
 
+impl crate::MotorLoad for PhotographedSim {
+    fn actuator_load(&self) -> shm_types::ActuatorLoad {
+        crate::MotorLoad::actuator_load(&self.sim)
+    }
+}
+
 impl Simulator for PhotographedSim {
     type Error = MujocoError;
 

@@ -11,6 +11,7 @@ use kinematics::robot::{EndEffector, Robot};
 use mujoco_rs::prelude::{MjData, MjModel, MjtObjBase, MjtWarning};
 use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3};
 
+use super::actuators::ActuatorRecord;
 use super::bodies::RigidBodies;
 use super::contact::{self, FootContacts, FootIds};
 use super::mjcf;
@@ -62,6 +63,10 @@ pub struct MujocoSim {
     initial_base_height: f64,
     /// Sum of the `dt`s stepped so far; the physics time follows it to within one time step.
     commanded_time: f64,
+    /// Torque and speed of every joint against its URDF limits.
+    actuators: ActuatorRecord,
+    /// Each servo's position reference over the current command period: from, to.
+    servo_ramps: Vec<(f64, f64)>,
 }
 
 impl MujocoSim {
@@ -97,6 +102,8 @@ impl MujocoSim {
         let layout = Layout::resolve(&model, &robot, &bodies)?;
         let data = MjData::new(Box::new(model));
         let measurement = SimMeasurement::at_rest(initial, Vector3::zeros());
+        let actuators = ActuatorRecord::new(&robot);
+        let dof = robot.model.dof();
         let mut sim = Self {
             robot,
             options,
@@ -109,6 +116,8 @@ impl MujocoSim {
             summary: SafetySummary::default(),
             initial_base_height: 0.0,
             commanded_time: 0.0,
+            actuators,
+            servo_ramps: vec![(0.0, 0.0); dof],
         };
         sim.place(initial);
         sim.initial_base_height = sim.base_link_pose().translation.z;
@@ -292,6 +301,13 @@ impl MujocoSim {
     }
 }
 
+impl crate::MotorLoad for MujocoSim {
+    /// How hard the motors have worked since the start, against the URDF's limits.
+    fn actuator_load(&self) -> shm_types::ActuatorLoad {
+        *self.actuators.load()
+    }
+}
+
 impl Layout {
     fn resolve(model: &MjModel, robot: &Robot, bodies: &RigidBodies) -> Result<Self, MujocoError> {
         let id = |kind: MjtObjBase, name: &str| {
@@ -380,14 +396,31 @@ impl Simulator for MujocoSim {
         for (j, ((&q, &qd), limit)) in q_des.iter().zip(qd_des).zip(limits).enumerate() {
             let target = q.clamp(limit.lower, limit.upper);
             violations += usize::from(target != q);
-            ctrl[2 * j] = target;
-            ctrl[2 * j + 1] = qd;
+            // The servo's reference moves no faster than the motor's rated speed.
+            let (from, reach) = (ctrl[2 * j], limit.velocity * dt);
+            self.servo_ramps[j] = (from, target.clamp(from - reach, from + reach));
+            ctrl[2 * j + 1] = qd.clamp(-limit.velocity, limit.velocity);
         }
         let warnings_before = self.fatal_warning_count();
         let mut period = FootContacts::default();
         for substep in 0..substeps {
+            // The servo drive ramps its position reference over the command period (a
+            // first-order hold) rather than jumping at its start: with kp 1e5 N·m/rad a jump of
+            // a milliradian is 100 N·m for one physics step.
+            let along = (substep + 1) as f64 / substeps as f64;
+            let ctrl = self.data.ctrl_mut();
+            for (j, &(from, to)) in self.servo_ramps.iter().enumerate() {
+                ctrl[2 * j] = from + (to - from) * along;
+            }
             // Forward dynamics of the current state, the constraint solve and the integration.
             self.data.step2();
+            let (torques, speeds) = (self.data.qfrc_actuator(), self.data.qvel());
+            let dofs = &self.layout.joint_dof;
+            self.actuators.observe(
+                dofs.iter().map(|&d| torques[d]),
+                dofs.iter().map(|&d| speeds[d]),
+                self.options.timestep,
+            );
             // The contact list, solved forces and poses still describe the same state here.
             if self.options.average_ft_over_step {
                 let reading = contact::read(&self.data, &self.layout.feet);
