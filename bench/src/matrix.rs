@@ -114,6 +114,7 @@ impl MatrixRun {
             sim_s: 0.0,
             drift_m: None,
             max_tilt_rad: 0.0,
+            actuators: None,
         };
         match result {
             Err(error) => Self {
@@ -132,6 +133,7 @@ impl MatrixRun {
                     sim_s: report.sim_s,
                     drift_m: Some(report.drift_m()),
                     max_tilt_rad: report.max_tilt_rad,
+                    actuators: Some(report.actuators.clone()),
                     ..record(report.outcome.label())
                 },
                 error: None,
@@ -201,6 +203,17 @@ fn run(args: &MatrixArgs) -> anyhow::Result<MatrixReport> {
         config.set(assignment)?;
     }
     let gait = Gait::chosen_or_configured(args.gait, &config)?;
+    walk_matrix(&config, args, gait)
+}
+
+/// Walks the matrix of `args` (its cells, rate, model error, push and jobs) for the robot of
+/// `config` in `gait`; `args.robot` and `args.overrides` are not read again (`walk-tune` walks
+/// configs of its own).
+pub fn walk_matrix(
+    config: &ConfigFile,
+    args: &MatrixArgs,
+    gait: Gait,
+) -> anyhow::Result<MatrixReport> {
     let options = walk_options(args, gait)?;
     let robot_name = config
         .section("robot")
@@ -209,7 +222,7 @@ fn run(args: &MatrixArgs) -> anyhow::Result<MatrixReport> {
         .unwrap_or("robot")
         .to_owned();
     let requests = args.cells.requests()?;
-    let runs = run_all(&config, args, &options, &requests);
+    let runs = run_all(config, args, &options, &requests);
     let groups = groups(&runs);
     Ok(MatrixReport {
         robot: robot_name,
@@ -383,6 +396,9 @@ fn print_table(report: &MatrixReport) {
             g.drift_max_m,
             group.tick_p99_max_us
         );
+        if let Some(actuators) = &g.actuators {
+            println!("{:<16} peak {}", "", actuators.describe());
+        }
     }
     println!("{} of {} runs done", report.done, report.runs.len());
 }

@@ -19,6 +19,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
+use client::evaluate::actuators::ActuatorReport;
 use client::evaluate::{Points, TraceSample, align_targets, stance_points};
 use daemon::controller::{
     BalanceStatus, Controller, ControllerConfig, ControllerState, ControllerStatus,
@@ -28,6 +29,7 @@ use kinematics::ConfigFile;
 use kinematics::ground::GRAVITY;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Vector2, Vector3};
+use sim_adapter::MotorLoad;
 use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim};
 use stance::poses::FEET;
 use stance::{PostProcessParams, PostProcessedSequence, WalkRequest, synthetic_walk};
@@ -176,6 +178,9 @@ pub struct PhysicsWalkReport {
     /// The controller's balance readings next to the simulator's CoM, every
     /// [`PhysicsWalkOptions::trace_every`] ticks.
     pub balance_trace: Vec<BalanceSample>,
+    /// How hard the walk worked the motors against the URDF's limits (the whole run, settle
+    /// time included).
+    pub actuators: ActuatorReport,
     /// Simulated time the [`PhysicsWalkOptions::push`] began (s): `None` without a push, or
     /// when the walk ended before its single support, so that a push sweep cannot count a walk
     /// that was never pushed as surviving.
@@ -397,6 +402,7 @@ pub fn walk_sequence(
         balance: loop_state.balance.tracking(),
         balance_trace: loop_state.balance_trace,
         pushed_at_s: loop_state.push.and_then(|push| push.applied_at),
+        actuators: ActuatorReport::new(&sim.actuator_load(), &robot),
     })
 }
 

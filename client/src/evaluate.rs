@@ -19,6 +19,7 @@
 //! only): target vs controller state vs simulator over time for the CoM and both feet
 //! ([`write_fig6`] is shared with the in-process physics walk of the `walk-tests` package).
 
+pub mod actuators;
 pub(crate) mod balance;
 pub mod fig6;
 pub mod filmstrip;
@@ -27,6 +28,7 @@ pub mod stop;
 pub(crate) mod truth;
 pub(crate) mod watch;
 
+use actuators::ActuatorReport;
 pub use fig6::{BalanceSample, write_fig6};
 pub use record::{GroupSummary, MatrixCells, WalkRecord, group_by_cell, speed_cell};
 
@@ -248,6 +250,7 @@ impl RunResult {
             "gait": self.gait.name(),
             "walked_m": r.walked_m,
             "speed_m_s": r.speed_m_s,
+            "actuators": r.actuators,
             "injected": self.stop.map(|stop| serde_json::json!({
                 "fault": stop.injection.fault.name(),
                 "at": stop.injection.moment.name(),
@@ -463,6 +466,8 @@ fn run_once(
             sim_s: walk.sim_s,
             drift_m: walk.drift.map(|(largest, _)| largest),
             max_tilt_rad: verdict.max_tilt_rad,
+            actuators: (args.physics == Physics::Mujoco)
+                .then(|| ActuatorReport::new(&verdict.end.actuators, model)),
         },
         wall_s: walk.wall_s,
         final_position_error_m: end.distances(&final_target).1,
@@ -479,7 +484,7 @@ fn run_once(
 fn row(result: &RunResult) -> String {
     let r = &result.record;
     format!(
-        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{}",
+        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{}{}",
         result.robot,
         result.gait.name(),
         r.affordances.name(),
@@ -498,7 +503,10 @@ fn row(result: &RunResult) -> String {
             .map_or_else(|| "n/a".to_owned(), |d| format!("{d:.4} m")),
         r.max_tilt_rad,
         result.stance_reached,
-        r.stances
+        r.stances,
+        r.actuators
+            .as_ref()
+            .map_or_else(String::new, |a| format!(" {}", a.describe()))
     )
 }
 
@@ -535,6 +543,16 @@ fn summary(results: &[RunResult]) -> String {
                 wall / n,
                 sim / wall
             );
+            if let Some(actuators) = &group.actuators {
+                let _ = writeln!(
+                    out,
+                    "{:<8} {:<16} {:>6.1} m  peak {}",
+                    "",
+                    "",
+                    group.distance_m,
+                    actuators.describe()
+                );
+            }
         }
     }
     out

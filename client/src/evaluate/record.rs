@@ -6,6 +6,7 @@ use serde::{Serialize, Serializer};
 use stance::{AffordanceSet, WalkRequest};
 
 use crate::args::DISTANCE_M;
+use crate::evaluate::actuators::ActuatorReport;
 
 /// The cells of the matrix a command walks: affordance sets × distances × runs (the command-line
 /// arguments both matrix commands share).
@@ -96,6 +97,9 @@ pub struct WalkRecord {
     pub drift_m: Option<f64>,
     /// Largest tilt of the simulated base link from the vertical (rad).
     pub max_tilt_rad: f64,
+    /// How hard the walk worked the motors (`None` without actuator dynamics: kinematic
+    /// physics).
+    pub actuators: Option<ActuatorReport>,
 }
 
 fn affordance_name<S: Serializer>(set: &AffordanceSet, serializer: S) -> Result<S::Ok, S::Error> {
@@ -120,6 +124,9 @@ pub struct GroupSummary {
     pub speed_min_m_s: Option<f64>,
     /// Largest drift of a walk (m).
     pub drift_max_m: f64,
+    /// Each joint group's largest peak torque and speed fraction over the walks, and the longest
+    /// saturation (`None` without actuator dynamics).
+    pub actuators: Option<ActuatorReport>,
 }
 
 /// `items` split into groups of one affordance set and distance (in the order the groups first
@@ -166,6 +173,10 @@ fn summary(affordances: AffordanceSet, distance_m: f64, records: &[&WalkRecord])
             .then(|| speeds.iter().sum::<f64>() / speeds.len() as f64),
         speed_min_m_s: speeds.iter().copied().reduce(f64::min),
         drift_max_m: records.iter().filter_map(|r| r.drift_m).fold(0.0, f64::max),
+        actuators: records
+            .iter()
+            .filter_map(|r| r.actuators.clone())
+            .reduce(|worst, next| worst.worst(&next)),
     }
 }
 
@@ -196,6 +207,7 @@ mod tests {
             sim_s: 10.0,
             drift_m: Some(speed / 10.0),
             max_tilt_rad: 0.0,
+            actuators: None,
         }
     }
 
