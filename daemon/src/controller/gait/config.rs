@@ -84,11 +84,13 @@ pub struct DynamicGaitConfig {
     pub stabilizer: StabilizerConfig,
 }
 
+/// The tuning that walks JVRC-1 under MuJoCo (configs/jvrc1.toml, 0.26 m/s), so an empty
+/// `[gait.dynamic]` walks an HRP-class robot; `walkctl init-robot` derives a robot's own.
 impl Default for DynamicGaitConfig {
     fn default() -> Self {
         Self {
-            single_support_s: 0.7,
-            double_support_s: 0.1,
+            single_support_s: 0.55,
+            double_support_s: 0.25,
             initial_double_support_s: 1.0,
             final_double_support_s: 1.0,
             stop_double_support_s: 0.6,
@@ -99,9 +101,9 @@ impl Default for DynamicGaitConfig {
             late_touchdown_max_s: 0.2,
             late_descent_speed: 0.05,
             late_lift_off_max_s: 0.2,
-            hand_weight: None,
+            hand_weight: Some(0.02),
             zmp_inward_offset_m: 0.0,
-            torso_posture_weight: None,
+            torso_posture_weight: Some(1.0),
             stabilizer: StabilizerConfig::default(),
         }
     }
@@ -159,19 +161,21 @@ pub struct StabilizerConfig {
     pub tilt_damping_max_rad: f64,
 }
 
+/// JVRC-1's stabilizer: DCM feedback, IMU tilt and the ZMP offset off (each made walks fall,
+/// docs/controller.md "Stabilizer"), foot damping, force difference and tilt damping on.
 impl Default for StabilizerConfig {
     fn default() -> Self {
         Self {
             zmp_margin_m: 0.01,
-            dcm_feedback: true,
-            dcm_gain: 2.0,
-            imu_tilt: true,
+            dcm_feedback: false,
+            dcm_gain: 3.0,
+            imu_tilt: false,
             velocity_filter_s: 0.01,
-            zmp_offset: true,
+            zmp_offset: false,
             zmp_offset_time_constant_s: 1.0,
             zmp_offset_max_m: 0.03,
             foot_damping: true,
-            foot_damping_gain: 1e-4,
+            foot_damping_gain: 5e-4,
             foot_damping_max_speed: 0.2,
             foot_damping_leak_s: 1.0,
             force_difference: true,
@@ -428,7 +432,19 @@ mod tests {
             DynamicGaitConfig::default().double_support_s
         );
         assert!(!dynamic.stabilizer.foot_damping);
-        assert!(dynamic.stabilizer.dcm_feedback);
+        assert!(dynamic.stabilizer.tilt_damping);
+    }
+
+    /// An empty `[gait.dynamic]` walks: its defaults are the tuning that walks JVRC-1 under
+    /// MuJoCo, and the stabilizer options docs/controller.md measured as harmful are off.
+    #[test]
+    fn the_defaults_are_the_tuning_that_walks_jvrc1() {
+        let jvrc1 = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/jvrc1.toml");
+        let tuned = GaitConfig::from_config_file(&jvrc1).unwrap();
+        assert_eq!(tuned.dynamic().unwrap(), &DynamicGaitConfig::default());
+        let empty = parse("[gait.dynamic]\n").unwrap();
+        let stabilizer = empty.dynamic().unwrap().stabilizer;
+        assert!(!stabilizer.dcm_feedback && !stabilizer.imu_tilt && !stabilizer.zmp_offset);
     }
 
     #[test]
