@@ -9,9 +9,11 @@
 //!
 //! - `matrix` (feature `mujoco`): `physics-matrix`, those walks over affordance sets ×
 //!   distances × seeds with config overrides, model error and pushes.
+//! - `tune` (feature `mujoco`): `walk-tune`, those matrices over step timing × step length, for
+//!   the fastest dynamic gait a robot walks without a fall.
 //!
-//! Binaries: `walk-bench` (a walk as fast as the machine runs), `physics-matrix` (feature
-//! `mujoco`) and `latency-report` (latency and deadline misses of the real multi-process
+//! Binaries: `walk-bench` (a walk as fast as the machine runs), `physics-matrix` and `walk-tune`
+//! (feature `mujoco`) and `latency-report` (latency and deadline misses of the real multi-process
 //! system). This crate, not `daemon`, links the
 //! simulators: walkd itself links none.
 
@@ -24,6 +26,9 @@ pub mod matrix;
 #[cfg(feature = "mujoco")]
 pub mod physics;
 pub mod sequence;
+/// `walk-tune`: the fastest dynamic gait that walks without a fall (feature `mujoco`).
+#[cfg(feature = "mujoco")]
+pub mod tune;
 pub mod walk;
 
 pub use closed_loop::{ClosedLoop, Readings, TickError};
