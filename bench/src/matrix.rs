@@ -200,7 +200,7 @@ fn run(args: &MatrixArgs) -> anyhow::Result<MatrixReport> {
     for assignment in &args.overrides {
         config.set(assignment)?;
     }
-    let gait = Gait::chosen_or_configured(args.gait, &config)?;
+    let gait = Gait::for_walk(args.gait, &config)?;
     let options = walk_options(args, gait)?;
     let robot_name = config
         .section("robot")
