@@ -100,7 +100,8 @@ pub struct BenchArgs {
     pub seed: u64,
     /// Gait: static or dynamic (default: the config's `[gait] default`). A generated walk is
     /// post-processed with its limits. The dynamic gait is judged by its ZMP, with the
-    /// stabilizer parts that need forces and inertia off (`walk_bench::kinematic_gaits`).
+    /// stabilizer parts that need forces and inertia off (`walk_bench::kinematic_gaits`). A
+    /// gait the robot cannot walk is refused before the walk.
     #[arg(long)]
     pub gait: Option<Gait>,
     /// Print one JSON object instead of text.
@@ -140,11 +141,11 @@ impl Timing {
 
 fn run(args: &BenchArgs) -> anyhow::Result<bool> {
     let file = ConfigFile::load(&args.robot)?;
+    let gait = Gait::for_walk(args.gait, &file)?;
     let robot = Arc::new(
         Robot::from_config(&file, args.urdf.as_deref())
             .with_context(|| format!("loading robot {}", args.robot.display()))?,
     );
-    let gait = Gait::chosen_or_configured(args.gait, &file)?;
     let params = PostProcessParams::from_config_for(&file, gait)?;
     let config = ControllerConfig::from_config(&file)?;
     let gaits = kinematic_gaits(&file)?;

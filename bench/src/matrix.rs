@@ -202,7 +202,7 @@ fn run(args: &MatrixArgs) -> anyhow::Result<MatrixReport> {
     for assignment in &args.overrides {
         config.set(assignment)?;
     }
-    let gait = Gait::chosen_or_configured(args.gait, &config)?;
+    let gait = Gait::for_walk(args.gait, &config)?;
     walk_matrix(&config, args, gait)
 }
 

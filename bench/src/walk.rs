@@ -17,7 +17,7 @@ use stance::PostProcessedSequence;
 use crate::closed_loop::{ClosedLoop, TickError, feet_midpoint};
 
 /// How to run a walk.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct WalkOptions {
     /// QP back-end.
     pub solver: SolverKind,

@@ -49,8 +49,8 @@ pub struct BenchCoverageArgs {
 
 /// Runs `walkctl bench-coverage`.
 pub fn run(args: &BenchCoverageArgs) -> anyhow::Result<()> {
-    let robot = load_robot(&args.robot, args.urdf.as_deref())?;
     let params = args.params.load(&args.robot)?;
+    let robot = load_robot(&args.robot, args.urdf.as_deref())?;
     let model = NgramModel::from_path(&args.model)?;
     let searches: Vec<Search> = if args.samples == 0 {
         vec![Search::Beam(8)]

@@ -77,8 +77,8 @@ fn mean_cv(samples: &[f64]) -> (f64, f64) {
 /// Runs `walkctl bench-postprocess`.
 pub fn run(args: &BenchPostprocessArgs) -> anyhow::Result<()> {
     anyhow::ensure!(args.runs >= 2, "--runs must be at least 2");
-    let robot = load_robot(&args.robot, args.urdf.as_deref())?;
     let params = args.params.load(&args.robot)?;
+    let robot = load_robot(&args.robot, args.urdf.as_deref())?;
     let mut processor = PostProcessor::new(&robot, params.clone());
     let mut output = PostProcessedSequence::empty();
     let mut samples = vec![0.0; args.runs];

@@ -76,7 +76,8 @@ pub struct DemoArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Gait: static or dynamic (default: the config's `[gait] default`). The walk is
-    /// post-processed with that gait's limits and asks walkd for it.
+    /// post-processed with that gait's limits and asks walkd for it. A gait the robot cannot
+    /// walk is refused before anything is started.
     #[arg(long)]
     pub gait: Option<Gait>,
     /// Print one JSON object instead of text.
@@ -230,13 +231,14 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         None => default_config(args.robot)?,
     };
     let file = ConfigFile::load(&config)?;
+    // A gait the robot cannot walk is refused before walkd and walk-sim are started.
+    let gait = Gait::for_walk(args.gait, &file)?;
     let runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())?;
     let prefix = args
         .service_prefix
         .clone()
         .unwrap_or(runtime.service_prefix);
     let robot = std::sync::Arc::new(Robot::from_config(&file, args.urdf.as_deref())?);
-    let gait = Gait::chosen_or_configured(args.gait, &file)?;
     let sequence = walk_sequence(&robot, &file, args.distance, args.seed, gait)?;
     let mut children = Processes::default();
     let running = DaemonClient::connect(&prefix).is_ok_and(|client| client.is_running());

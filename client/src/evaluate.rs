@@ -75,7 +75,8 @@ pub struct EvaluateArgs {
     #[arg(long)]
     pub json: bool,
     /// Gait: static or dynamic (default: each robot config's `[gait] default`). The walks are
-    /// post-processed with that gait's limits and ask walkd for it.
+    /// post-processed with that gait's limits and ask walkd for it. Every robot is checked
+    /// before the first run: one that cannot walk the gait is refused.
     #[arg(long)]
     pub gait: Option<Gait>,
     /// Write Fig. 6 per robot (`fig6_<robot>.svg`) into this directory.
@@ -266,41 +267,73 @@ impl RunResult {
     }
 }
 
+/// A robot of the matrix, loaded and checked before the first run starts a process.
+struct Subject<'a> {
+    /// Config name.
+    robot: &'a str,
+    /// Its config file, and that file loaded.
+    config: PathBuf,
+    file: ConfigFile,
+    /// Its model.
+    model: Arc<Robot>,
+    /// The gait its walks use (`--gait`, else its config's default).
+    gait: Gait,
+    /// The fault injections of each walk.
+    injections: Vec<Option<Injection>>,
+}
+
+impl<'a> Subject<'a> {
+    /// Loads robot `robot` of the matrix; refuses it when it cannot walk the gait.
+    fn load(args: &EvaluateArgs, robot: &'a str) -> anyhow::Result<Self> {
+        let config = args.config_dir.join(format!("{robot}.toml"));
+        let file = ConfigFile::load(&config)?;
+        let gait = Gait::for_walk(args.gait, &file)?;
+        let model = Arc::new(
+            Robot::from_config(&file, args.urdf.as_deref())
+                .with_context(|| format!("robot `{robot}` ({})", config.display()))?,
+        );
+        let injections = args.inject.injections(&file)?;
+        Ok(Self {
+            robot,
+            config,
+            file,
+            model,
+            gait,
+            injections,
+        })
+    }
+}
+
 /// `walkctl evaluate`: runs the matrix, prints the table or JSON, writes the plots; fails unless
 /// every run succeeded.
 pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
     let requests = args.cells.requests()?;
+    let subjects = args
+        .robots
+        .iter()
+        .map(|robot| Subject::load(args, robot))
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let mut results = Vec::new();
-    for robot in &args.robots {
-        let config = args.config_dir.join(format!("{robot}.toml"));
-        let model = Arc::new(
-            Robot::load(&config, args.urdf.as_deref())
-                .with_context(|| format!("robot `{robot}` ({})", config.display()))?,
-        );
-        let injections = args.inject.injections(&ConfigFile::load(&config)?)?;
-        let runs = requests
-            .iter()
-            .flat_map(|request| injections.iter().map(move |injection| (request, injection)));
+    for subject in &subjects {
+        let robot = subject.robot;
+        let runs = requests.iter().flat_map(|request| {
+            subject
+                .injections
+                .iter()
+                .map(move |injection| (request, injection))
+        });
         for (i, (request, injection)) in runs.enumerate() {
             let pictured = args.snapshots.as_deref().filter(|_| i == 0);
-            let result = run_once(
-                args,
-                robot,
-                &model,
-                &config,
-                (i, request),
-                *injection,
-                pictured,
-            )
-            .with_context(|| {
-                format!(
-                    "{robot} {} {} m run {}{}",
-                    request.affordances,
-                    request.distance,
-                    request.seed,
-                    injection.map_or_else(String::new, |i| format!(" ({})", i.label()))
-                )
-            })?;
+            let result =
+                run_once(args, subject, (i, request), *injection, pictured).with_context(|| {
+                    format!(
+                        "{robot} {} {} m run {}{}",
+                        request.affordances,
+                        request.distance,
+                        request.seed,
+                        injection.map_or_else(String::new, |i| format!(" ({})", i.label()))
+                    )
+                })?;
             if !args.json {
                 eprintln!("{}", row(&result));
             }
@@ -349,16 +382,21 @@ fn plot_robot(dir: &Path, robot: &str, results: &[RunResult]) -> anyhow::Result<
 /// there.
 fn run_once(
     args: &EvaluateArgs,
-    robot: &str,
-    model: &Arc<Robot>,
-    config: &Path,
+    subject: &Subject,
     (slot, request): (usize, &WalkRequest),
     injection: Option<Injection>,
     pictured: Option<&Path>,
 ) -> anyhow::Result<RunResult> {
-    let file = ConfigFile::load(config)?;
-    let gait = Gait::chosen_or_configured(args.gait, &file)?;
-    let params = stance::PostProcessParams::from_config_for(&file, gait)?;
+    let Subject {
+        robot,
+        config,
+        file,
+        model,
+        gait,
+        ..
+    } = subject;
+    let (robot, gait) = (*robot, *gait);
+    let params = stance::PostProcessParams::from_config_for(file, gait)?;
     let &WalkRequest {
         distance,
         affordances,
@@ -377,7 +415,7 @@ fn run_once(
         urdf: args.urdf.clone(),
     };
     let frames = pictured.map(|dir| dir.join(format!("frames-{robot}")));
-    let plant = PlantArgs::new(args.physics, gait, &file);
+    let plant = PlantArgs::new(args.physics, gait, file);
     let mut sim_args = plant.walk_sim;
     if let Some(frames) = &frames {
         let _ = std::fs::remove_dir_all(frames);

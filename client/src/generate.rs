@@ -4,9 +4,10 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
+use kinematics::ConfigFile;
 use kinematics::bounds::Range;
 use stance::learned::SourceArgs;
-use stance::{AffordanceSet, GenerateOptions};
+use stance::{AffordanceSet, Gait, GenerateOptions};
 
 use crate::args::DISTANCE_M;
 use crate::postprocess::{ParamOverrides, load_robot};
@@ -56,6 +57,9 @@ fn parse_interval(text: &str) -> Result<[f64; 2], String> {
 
 /// Runs `walkctl generate`.
 pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
+    // The gait only picks the limits (`scf`) here, but a walk the robot cannot make is refused
+    // now, before anything is written, rather than by walkd.
+    Gait::for_walk(args.params.gait, &ConfigFile::load(&args.robot)?)?;
     let robot = load_robot(&args.robot, args.urdf.as_deref())?;
     let scale = if args.raw_distance {
         1.0

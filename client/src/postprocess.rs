@@ -14,7 +14,8 @@ use stance::{ContactUnification, Gait, PostProcessParams, PostProcessor, RawSequ
 pub struct ParamOverrides {
     /// The gait whose limits to start from (`[postprocess]`, or with the dynamic gait's
     /// `[postprocess.dynamic]` overrides); the output asks walkd for that gait. Default: the
-    /// config's `[gait] default`.
+    /// config's `[gait] default`. A gait the robot cannot walk (dynamic without
+    /// `[gait.dynamic]`) is refused.
     #[arg(long)]
     pub gait: Option<Gait>,
     /// Sequence scaling factor (0, 1].
@@ -58,10 +59,11 @@ fn parse_unification(s: &str) -> Result<ContactUnification, String> {
 }
 
 impl ParamOverrides {
-    /// The config's parameters for the gait, with these overrides applied and re-validated.
+    /// The config's parameters for the gait, with these overrides applied and re-validated;
+    /// refuses a gait the robot cannot walk ([`Gait::for_walk`]).
     pub fn load(&self, config: &Path) -> anyhow::Result<PostProcessParams> {
         let file = ConfigFile::load(config)?;
-        let gait = Gait::chosen_or_configured(self.gait, &file)?;
+        let gait = Gait::for_walk(self.gait, &file)?;
         let mut p = PostProcessParams::from_config_for(&file, gait)?;
         let fields = [
             (self.scf, &mut p.scf),
@@ -116,8 +118,8 @@ pub struct PostprocessArgs {
 
 /// Runs `walkctl postprocess`.
 pub fn run(args: &PostprocessArgs) -> anyhow::Result<()> {
-    let robot = load_robot(&args.robot, args.urdf.as_deref())?;
     let params = args.params.load(&args.robot)?;
+    let robot = load_robot(&args.robot, args.urdf.as_deref())?;
     let text = std::fs::read_to_string(&args.input)
         .with_context(|| format!("reading {}", args.input.display()))?;
     let raw = RawSequence::from_json_str(&text, &robot)

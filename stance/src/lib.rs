@@ -40,7 +40,7 @@ pub use generate::{
     AffordanceSet, GenerateError, GenerateOptions, generate, generate_with_railing,
 };
 pub use geometry::PathFrame;
-pub use params::{ContactUnification, Gait, ParamsError, PostProcessParams};
+pub use params::{ContactUnification, Gait, GaitUnavailable, ParamsError, PostProcessParams};
 pub use pipeline::PostProcessor;
 pub use poses::PoseSequence;
 pub use sequence::{PostProcessedSequence, RawSequence, Stance, StanceSequence};

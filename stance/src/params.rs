@@ -43,7 +43,37 @@ impl Gait {
         }
     }
 
-    /// `choice`, or the config's `[gait] default` when the user made none.
+    /// The gait a walk on the robot of `file` uses: `choice`, else the config's `[gait]
+    /// default`, refused when the robot cannot walk it ([`Gait::available_in`]). Every client
+    /// command that takes `--gait` resolves it here right after loading the config, so a
+    /// refusal comes before any process is started or file written, not from walkd.
+    pub fn for_walk(choice: Option<Self>, file: &ConfigFile) -> Result<Self, ParamsError> {
+        let gait = Self::chosen_or_configured(choice, file)?;
+        gait.available_in(file)?;
+        Ok(gait)
+    }
+
+    /// Whether the robot of `file` can walk this gait: the static gait always, the dynamic gait
+    /// only with a `[gait.dynamic]` table (its tuning; an empty one takes the defaults). The one
+    /// home of this rule and of its message, shared by the client (which refuses up front) and
+    /// walkd (`daemon::controller::GaitConfig::dynamic`, which refuses a submitted sequence).
+    pub fn available_in(self, file: &ConfigFile) -> Result<(), GaitUnavailable> {
+        let tuned = || {
+            file.section("gait")
+                .and_then(|gait| gait.get("dynamic"))
+                .is_some_and(toml::Value::is_table)
+        };
+        match self {
+            Self::Static => Ok(()),
+            Self::Dynamic if tuned() => Ok(()),
+            Self::Dynamic => Err(GaitUnavailable {
+                path: file.path().to_owned(),
+            }),
+        }
+    }
+
+    /// `choice`, or the config's `[gait] default` when the user made none (a walk resolves its
+    /// gait with [`Gait::for_walk`], which also checks that the robot can walk it).
     pub fn chosen_or_configured(
         choice: Option<Self>,
         file: &ConfigFile,
@@ -137,7 +167,23 @@ pub struct PostProcessParams {
     pub gait: Gait,
 }
 
-/// Why the `[postprocess]` section could not be used.
+/// Why a robot cannot walk a gait: the dynamic gait needs its tuning, `[gait.dynamic]`, and the
+/// robot config has none. A type of its own so the client and walkd refuse with one message,
+/// which names the file, the missing section and the fix.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "the robot config {path} has no [gait.dynamic] section, so this robot walks statically \
+     only; add a [gait.dynamic] section to {path}: an empty one takes the defaults \
+     (docs/controller.md, \"Dynamic gait\"), or derive one for the robot with \
+     `walkctl init-robot`",
+    path = path.display()
+)]
+pub struct GaitUnavailable {
+    /// The robot config without `[gait.dynamic]`.
+    pub path: PathBuf,
+}
+
+/// Why the `[postprocess]` section, or the gait a walk asks for, could not be used.
 #[derive(Debug, thiserror::Error)]
 pub enum ParamsError {
     /// The config file could not be read or parsed.
@@ -153,6 +199,9 @@ pub enum ParamsError {
         section: &'static str,
         message: String,
     },
+    /// The robot cannot walk the gait asked for ([`Gait::for_walk`]).
+    #[error(transparent)]
+    Unavailable(#[from] GaitUnavailable),
     /// A value outside its domain.
     #[error("{origin}: [postprocess] key `{key}`: {message}")]
     Invalid {
@@ -358,6 +407,60 @@ mod tests {
                 "{error}"
             );
         }
+    }
+
+    #[test]
+    fn the_dynamic_gait_needs_its_section_and_the_refusal_names_the_file_and_the_fix() {
+        let path = Path::new("configs/robot.toml");
+        let file = |text: &str| ConfigFile::parse(text, path).unwrap();
+        for text in ["", "[gait]\n", "[gait]\ndefault = \"static\"\n"] {
+            assert_eq!(Gait::Static.available_in(&file(text)), Ok(()), "{text:?}");
+            let error = Gait::Dynamic.available_in(&file(text)).unwrap_err();
+            assert_eq!(error.path, path);
+            let message = error.to_string();
+            for part in [
+                "the robot config configs/robot.toml has no [gait.dynamic] section",
+                "add a [gait.dynamic] section to configs/robot.toml: an empty one takes the \
+                 defaults (docs/controller.md, \"Dynamic gait\")",
+                "`walkctl init-robot`",
+            ] {
+                assert!(message.contains(part), "{part:?} not in {message:?}");
+            }
+        }
+        for text in [
+            "[gait.dynamic]\n",
+            "[gait]\n[gait.dynamic]\nsingle_support_s = 0.6\n",
+        ] {
+            for gait in [Gait::Static, Gait::Dynamic] {
+                assert_eq!(gait.available_in(&file(text)), Ok(()), "{gait:?} {text:?}");
+            }
+        }
+        // Not a table: no tuning either.
+        assert!(
+            Gait::Dynamic
+                .available_in(&file("[gait]\ndynamic = 1\n"))
+                .is_err()
+        );
+    }
+
+    #[test]
+    fn a_walk_takes_the_chosen_or_the_default_gait_if_the_robot_can_walk_it() {
+        let file = |text: &str| ConfigFile::parse(text, Path::new("r.toml")).unwrap();
+        let statically = file("[gait]\ndefault = \"static\"\n");
+        assert_eq!(Gait::for_walk(None, &statically).unwrap(), Gait::Static);
+        let refused = Gait::for_walk(Some(Gait::Dynamic), &statically).unwrap_err();
+        assert!(
+            matches!(&refused, ParamsError::Unavailable(GaitUnavailable { path }) if path == Path::new("r.toml")),
+            "{refused:?}"
+        );
+        let dynamic = file("[gait]\ndefault = \"dynamic\"\n[gait.dynamic]\n");
+        assert_eq!(Gait::for_walk(None, &dynamic).unwrap(), Gait::Dynamic);
+        assert_eq!(
+            Gait::for_walk(Some(Gait::Static), &dynamic).unwrap(),
+            Gait::Static
+        );
+        // A dynamic default without its section (walkd refuses such a config at load).
+        assert!(Gait::for_walk(None, &file("[gait]\ndefault = \"dynamic\"\n")).is_err());
     }
 
     #[test]

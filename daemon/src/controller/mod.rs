@@ -318,7 +318,7 @@ impl Controller {
     ) -> Result<PreparedSequence, Refusal> {
         let mut prepared = PreparedSequence::new(robot, config, seq)?;
         if gait == Gait::Dynamic {
-            let dynamic = gaits.dynamic().map_err(Refusal)?;
+            let dynamic = gaits.dynamic().map_err(|e| Refusal(e.to_string()))?;
             let plan = DynamicPlan::new(robot, &prepared.stances, dynamic)?;
             prepared.dynamic = Some(Box::new(plan));
         }

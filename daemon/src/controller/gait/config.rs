@@ -3,10 +3,10 @@
 //! (`[gait.dynamic]`, `[gait.dynamic.stabilizer]`). Every key is optional; an unknown key is an
 //! error naming the file, the table and the key.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
-use stance::Gait;
+use stance::{Gait, GaitUnavailable};
 
 use kinematics::ConfigFile;
 use kinematics::bounds::Bound;
@@ -16,13 +16,16 @@ use crate::controller::config::{ConfigError, check};
 
 /// What a robot config says about gaits. Without a `[gait]` section a robot walks statically
 /// only.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[derive(Clone, Debug, PartialEq, Default)]
 pub struct GaitConfig {
     /// The gait of a walk that does not ask for one (`[gait] default`, `static` if absent).
     pub default: Gait,
     /// The dynamic gait's tuning; `None` when the config has no `[gait.dynamic]`, and then a
     /// dynamic walk is refused.
     pub dynamic: Option<DynamicGaitConfig>,
+    /// The robot config this was read from, named when a dynamic walk is refused (empty for
+    /// [`GaitConfig::default`]).
+    pub path: PathBuf,
 }
 
 /// Timing, pendulum and touchdown parameters of the dynamic gait (`[gait.dynamic]`).
@@ -206,13 +209,17 @@ impl GaitConfig {
             section: GAIT,
             message: e.to_string(),
         })?;
-        Self::from_section(file.section(GAIT), default, &file.origin())
+        Ok(Self {
+            path: file.path().to_owned(),
+            ..Self::from_section(file.section(GAIT), default, &file.origin())?
+        })
     }
 
-    /// The dynamic gait's tuning, or why a dynamic walk cannot be executed on this robot.
-    pub fn dynamic(&self) -> Result<&DynamicGaitConfig, String> {
-        self.dynamic.as_ref().ok_or_else(|| {
-            "the robot config has no [gait.dynamic] section, so this robot walks statically only".to_owned()
+    /// The dynamic gait's tuning, or why a dynamic walk cannot be executed on this robot (the
+    /// client's up-front refusal, `stance::Gait::available_in`, says the same).
+    pub fn dynamic(&self) -> Result<&DynamicGaitConfig, GaitUnavailable> {
+        self.dynamic.as_ref().ok_or_else(|| GaitUnavailable {
+            path: self.path.clone(),
         })
     }
 
@@ -231,7 +238,7 @@ impl GaitConfig {
         let GaitSection {} = deserialize(section, origin, GAIT)?;
         let mut config = Self {
             default,
-            dynamic: None,
+            ..Self::default()
         };
         if let Some(dynamic) = dynamic {
             let mut dynamic = sub_table(&dynamic, origin, DYNAMIC)?;
@@ -400,10 +407,20 @@ mod tests {
 
     #[test]
     fn without_a_gait_section_the_robot_walks_statically_only() {
-        let config = parse("[controller]\n").unwrap();
+        let file = ConfigFile::parse("[controller]\n", Path::new("robot.toml")).unwrap();
+        let config = GaitConfig::from_config(&file).unwrap();
         assert_eq!(config.default, Gait::Static);
-        let reason = config.dynamic().unwrap_err();
-        assert!(reason.contains("[gait.dynamic]"), "{reason}");
+        // walkd refuses a dynamic walk as the client does up front: the file, section and fix.
+        let refusal = config.dynamic().unwrap_err();
+        assert_eq!(refusal, Gait::Dynamic.available_in(&file).unwrap_err());
+        assert_eq!(refusal.path, Path::new("robot.toml"));
+    }
+
+    #[test]
+    fn an_empty_dynamic_section_takes_the_defaults() {
+        // The refusal's fix says so.
+        let config = parse("[gait.dynamic]\n").unwrap();
+        assert_eq!(config.dynamic().unwrap(), &DynamicGaitConfig::default());
     }
 
     #[test]
