@@ -195,6 +195,10 @@ fn daemon_and_client_flags() -> Vec<Flag> {
         &["bench-postprocess", "--robot", &cfg],
         &[("--runs", None), ("--seed", None)],
     ));
+    flags.extend(parsed::<client::init_robot::InitRobotArgs>(
+        &["init-robot", "--urdf", "robot.urdf"],
+        &[("--sole", None), ("--sole-below", None)],
+    ));
     flags.extend(parsed::<client::watch::WatchArgs>(
         &["watch"],
         &[("--timeout-s", None)],
@@ -256,7 +260,8 @@ fn bench_flags() -> Vec<Flag> {
 }
 
 /// The values tried for `flag`: hostile ones and random ones over many magnitudes, shaped as
-/// the flag takes them (`FROM:TO` for `--railing`, `x,y,z` for `--pelvis-com-offset`).
+/// the flag takes them (`FROM:TO` for `--railing`, `x,y,z` for `--pelvis-com-offset`, `LxW`
+/// for `--sole`).
 fn values(flag: &str, rng: &mut ChaCha8Rng) -> Vec<String> {
     let mut numbers: Vec<String> = fuzz_values::HOSTILE.map(str::to_owned).to_vec();
     numbers.push(String::new());
@@ -265,6 +270,10 @@ fn values(flag: &str, rng: &mut ChaCha8Rng) -> Vec<String> {
         "--railing" => numbers
             .iter()
             .flat_map(|v| [format!("0:{v}"), format!("{v}:1")])
+            .collect(),
+        "--sole" => numbers
+            .iter()
+            .flat_map(|v| [format!("0.2x{v}"), format!("{v}x0.08")])
             .collect(),
         "--pelvis-com-offset" | "--distances" => numbers
             .iter()

@@ -13,6 +13,7 @@ pub mod daemon_client;
 pub mod demo;
 pub mod evaluate;
 pub mod generate;
+pub mod init_robot;
 pub mod inspect;
 pub mod learn;
 pub mod observe;

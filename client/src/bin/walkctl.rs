@@ -17,6 +17,8 @@ struct Cli {
 enum Command {
     /// Print a robot model's kinematics (links, frames, CoM, Jacobians) as JSON.
     Inspect(client::inspect::InspectArgs),
+    /// Write a starting robot config derived from a URDF (or from a robot's dimensions).
+    InitRobot(client::init_robot::InitRobotArgs),
     /// Generate a human-like, impeded raw stance sequence for a robot.
     Generate(client::generate::GenerateArgs),
     /// Post-process a raw stance sequence (Algorithm 1) into an executable one.
@@ -51,6 +53,7 @@ fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Inspect(args) => client::inspect::run(args),
+        Command::InitRobot(args) => client::init_robot::run(args),
         Command::Submit(args) => client::submit::run(args),
         Command::Status(args) => client::status::run(args),
         Command::Watch(args) => client::watch::run(args),
