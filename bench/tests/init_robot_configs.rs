@@ -1,7 +1,8 @@
-//! The configs `walkctl init-robot` derives — from the URDFs of JVRC-1, ARMAR-4 and iCub, from
-//! HRP-4's dimensions file, and the committed configs/icub.toml — are read by every loader walkd,
-//! walk-sim and walkctl use: the daemon's `[controller]` and `[gait]` parsers (which the client
-//! cannot link), `[runtime]`, both gaits' `[postprocess]` and the robot itself.
+//! The configs `walkctl init-robot` derives — from the URDFs of JVRC-1, ARMAR-4 and iCub, and
+//! the committed configs/icub.toml and configs/hrp4.toml (HRP-4 from its published dimensions)
+//! — are read by every loader walkd, walk-sim and walkctl use: the daemon's `[controller]` and
+//! `[gait]` parsers (which the client cannot link), `[runtime]`, both gaits' `[postprocess]` and
+//! the robot itself.
 
 use std::path::{Path, PathBuf};
 
@@ -94,19 +95,16 @@ fn the_committed_icub_config_loads_everywhere() {
     );
 }
 
+/// HRP-4 as shipped (derived from its published dimensions, its model not public): every
+/// section loads, and the dynamic gait is one it can walk.
 #[test]
-fn hrp4_from_its_dimensions_loads_everywhere_but_the_model() {
-    let args = [
-        "--dimensions".to_owned(),
-        workspace("configs/robots/hrp4/dimensions.toml")
-            .to_string_lossy()
-            .into_owned(),
-        "--frames-from".to_owned(),
-        workspace("configs/hrp4.toml")
-            .to_string_lossy()
-            .into_owned(),
-    ];
-    let path = generated("hrp4", &args);
+fn the_committed_hrp4_config_loads_everywhere_but_the_model() {
+    let path = workspace("configs/hrp4.toml");
     let (_, gaits) = load_everything(&path, false);
     assert!(gaits.dynamic.is_some());
+    let file = ConfigFile::load(&path).unwrap();
+    assert_eq!(
+        Gait::for_walk(Some(Gait::Dynamic), &file).unwrap(),
+        Gait::Dynamic
+    );
 }

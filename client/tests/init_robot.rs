@@ -1,5 +1,6 @@
 //! `walkctl init-robot` end to end: the binary on the vendored URDFs, its output loaded by the
-//! robot and stance loaders, the committed `configs/icub.toml` regenerated, bad input refused.
+//! robot and stance loaders, the committed `configs/icub.toml` and `configs/hrp4.toml`
+//! regenerated, bad input refused.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -103,31 +104,35 @@ struct Cli {
     args: InitRobotArgs,
 }
 
+/// The shipped configs that `walkctl init-robot` wrote (iCub from its URDF, HRP-4 from its
+/// published dimensions) are exactly what it writes now: nothing in them was edited by hand.
 #[test]
-fn the_committed_icub_config_is_what_init_robot_writes() {
-    let committed = std::fs::read_to_string(workspace("configs/icub.toml")).unwrap();
-    // The header records the command that wrote it (run from the repository root).
-    let command = committed
-        .lines()
-        .nth(1)
-        .and_then(|line| line.strip_prefix("#   "))
-        .expect("the command on the second line");
-    let words: Vec<String> = command.split_whitespace().map(str::to_owned).collect();
-    assert_eq!(&words[..2], ["walkctl", "init-robot"]);
-    // Paths as the repository root sees them.
-    let argv = words[2..].iter().map(|word| {
-        if word.starts_with("configs/") {
-            workspace(word).to_string_lossy().into_owned()
-        } else {
-            word.clone()
-        }
-    });
-    let cli = Cli::try_parse_from(std::iter::once("walkctl".to_owned()).chain(argv)).unwrap();
-    let generated = generate(&cli.args, command).expect("generates");
-    assert!(
-        generated.text == committed,
-        "configs/icub.toml differs from what `{command}` writes now; regenerate it"
-    );
+fn the_committed_derived_configs_are_what_init_robot_writes() {
+    for file in ["configs/icub.toml", "configs/hrp4.toml"] {
+        let committed = std::fs::read_to_string(workspace(file)).unwrap();
+        // The header records the command that wrote it (run from the repository root).
+        let command = committed
+            .lines()
+            .nth(1)
+            .and_then(|line| line.strip_prefix("#   "))
+            .expect("the command on the second line");
+        let words: Vec<String> = command.split_whitespace().map(str::to_owned).collect();
+        assert_eq!(&words[..2], ["walkctl", "init-robot"]);
+        // Paths as the repository root sees them.
+        let argv = words[2..].iter().map(|word| {
+            if word.starts_with("configs/") {
+                workspace(word).to_string_lossy().into_owned()
+            } else {
+                word.clone()
+            }
+        });
+        let cli = Cli::try_parse_from(std::iter::once("walkctl".to_owned()).chain(argv)).unwrap();
+        let generated = generate(&cli.args, command).expect("generates");
+        assert!(
+            generated.text == committed,
+            "{file} differs from what `{command}` writes now; regenerate it"
+        );
+    }
 }
 
 #[test]

@@ -143,7 +143,10 @@ pub fn generate(args: &InitRobotArgs, command: &str) -> anyhow::Result<Generated
     };
     let robot_origin = match (&args.urdf, &args.frames_from) {
         (Some(_), _) => GUESSED.to_owned(),
-        (None, Some(config)) => format!("The [robot] section is copied from {}.", config.display()),
+        // The command line above names the file.
+        (None, Some(_)) => {
+            "The [robot] section is copied from the --frames-from config.".to_owned()
+        }
         (None, None) => "There is no [robot] section: write one (docs/kinematics.md).".to_owned(),
     };
     let derived = derive::derive(&dimensions);

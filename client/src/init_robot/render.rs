@@ -256,7 +256,7 @@ pub fn copied_robot_section(config_text: &str, origin: &str) -> anyhow::Result<S
     }
     Ok(format!(
         "{}{}\n",
-        comment(&format!("[robot] copied from {origin} (--frames-from)")),
+        comment("[robot] copied from the --frames-from config"),
         lines.join("\n")
     ))
 }
