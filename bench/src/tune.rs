@@ -313,46 +313,25 @@ fn write_keys(path: &Path, keys: &SpeedKeys) -> anyhow::Result<()> {
 fn set_line(text: &str, section: &str, key: &str, value: f64) -> String {
     let line = format!("{key} = {value}  # walk-tune");
     let header = format!("[{section}]");
-    let mut out: Vec<String> = Vec::new();
-    let (mut inside, mut found_table, mut done) = (false, false, false);
-    for current in text.lines() {
-        let trimmed = current.trim_start();
-        if trimmed.starts_with('[') {
-            if inside && !done {
-                // The table ended without the key: it goes right after the header.
-                let at = out
-                    .iter()
-                    .rposition(|l| l.trim() == header)
-                    .expect("header seen");
-                out.insert(at + 1, line.clone());
-                done = true;
-            }
-            inside = trimmed.trim_end() == header;
-            found_table |= inside;
-        } else if inside && !done {
-            let name = trimmed.split('=').next().unwrap_or("").trim();
-            if name == key && trimmed.contains('=') {
-                out.push(line.clone());
-                done = true;
-                continue;
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    match lines.iter().position(|l| l.trim() == header) {
+        None => lines.extend([String::new(), header, line]),
+        Some(start) => {
+            let end = lines[start + 1..]
+                .iter()
+                .position(|l| l.trim_start().starts_with('['))
+                .map_or(lines.len(), |i| start + 1 + i);
+            let names_key = |l: &String| {
+                let t = l.trim_start();
+                t.contains('=') && t.split('=').next().unwrap_or("").trim() == key
+            };
+            match (start + 1..end).find(|&i| names_key(&lines[i])) {
+                Some(i) => lines[i] = line,
+                None => lines.insert(start + 1, line),
             }
         }
-        out.push(current.to_owned());
     }
-    if inside && !done {
-        let at = out
-            .iter()
-            .rposition(|l| l.trim() == header)
-            .expect("header seen");
-        out.insert(at + 1, line.clone());
-        done = true;
-    }
-    if !found_table && !done {
-        out.push(String::new());
-        out.push(header);
-        out.push(line);
-    }
-    let mut joined = out.join("\n");
+    let mut joined = lines.join("\n");
     joined.push('\n');
     joined
 }

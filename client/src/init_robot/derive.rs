@@ -965,11 +965,14 @@ mod tests {
             ("controller", "com_speed"),
             ("controller", "swing_speed"),
         ];
-        for (table, key) in increasing {
-            let values: Vec<f64> = derived
+        let values = |table: &str, key: &str| -> Vec<f64> {
+            derived
                 .iter()
                 .map(|d| d.number(table, key).unwrap())
-                .collect();
+                .collect()
+        };
+        for (table, key) in increasing {
+            let values = values(table, key);
             assert!(
                 values.windows(2).all(|w| w[0] < w[1]),
                 "[{table}] {key}: {values:?}"
@@ -980,10 +983,7 @@ mod tests {
             ("gait.dynamic.stabilizer", "force_difference_gain"),
         ];
         for (table, key) in decreasing {
-            let values: Vec<f64> = derived
-                .iter()
-                .map(|d| d.number(table, key).unwrap())
-                .collect();
+            let values = values(table, key);
             assert!(
                 values.windows(2).all(|w| w[0] > w[1]),
                 "[{table}] {key}: {values:?}"
