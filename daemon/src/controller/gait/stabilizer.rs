@@ -200,7 +200,11 @@ mod tests {
 
     #[test]
     fn the_desired_zmp_is_clamped_into_the_support() {
-        let config = StabilizerConfig::default();
+        let config = StabilizerConfig {
+            dcm_feedback: true,
+            zmp_offset: true,
+            ..Default::default()
+        };
         let mut stabilizer = Stabilizer::new(config, OMEGA);
         stabilizer.reset(config, OMEGA, Vector2::zeros());
         // A large DCM error to the left would ask for a ZMP far outside the foot.
@@ -270,7 +274,11 @@ mod tests {
 
     #[test]
     fn the_zmp_offset_learns_a_com_model_error() {
-        let config = StabilizerConfig::default();
+        let config = StabilizerConfig {
+            dcm_feedback: true,
+            zmp_offset: true,
+            ..Default::default()
+        };
         let mut stabilizer = Stabilizer::new(config, OMEGA);
         stabilizer.reset(config, OMEGA, Vector2::zeros());
         let error = Vector2::new(0.01, -0.005);
