@@ -14,7 +14,7 @@
 //! (the keys' lines are rewritten, the rest of the file is kept byte for byte).
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
@@ -305,7 +305,7 @@ fn write_keys(path: &Path, keys: &SpeedKeys) -> anyhow::Result<()> {
             path.display()
         );
     }
-    std::fs::write(path, text).with_context(|| format!("writing {}", PathBuf::from(path).display()))
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
 }
 
 /// `text` with `key = value` in `[section]`: the key's line replaced (its comment becomes

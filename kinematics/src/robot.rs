@@ -111,6 +111,19 @@ pub struct JointGroups {
     pub head: Vec<usize>,
 }
 
+impl JointGroups {
+    /// The groups with their `[robot.joint_groups]` keys, in one fixed order (legs, arms, torso,
+    /// head): the order of per-group arrays such as the simulator's actuator load.
+    pub fn named(&self) -> [(&'static str, &[usize]); 4] {
+        [
+            ("legs", &self.legs),
+            ("arms", &self.arms),
+            ("torso", &self.torso),
+            ("head", &self.head),
+        ]
+    }
+}
+
 /// Names of the FT sensor frames added to the model.
 pub const FT_SENSOR_FRAMES: [&str; 2] = ["left_ft_sensor", "right_ft_sensor"];
 

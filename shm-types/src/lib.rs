@@ -44,8 +44,8 @@ pub use config::{ConfigError, RuntimeBound, RuntimeConfig, RuntimeOverrides, WAT
 pub use error::ShmError;
 pub use messages::{
     ActuatorLoad, ClockMode, CommandMode, ControlCommand, ControlReply, ControlRequest,
-    DaemonState, DaemonStatus, FAULT_TEXT, HISTOGRAM_BUCKETS, JOINT_GROUPS, JointCommand,
-    LatencySummary, LinkState, LogHistogram, SensorSample, SimTruth, SubmitReply, WRENCH_ORDER,
+    DaemonState, DaemonStatus, FAULT_TEXT, HISTOGRAM_BUCKETS, JointCommand, LatencySummary,
+    LinkState, LogHistogram, SensorSample, SimTruth, SubmitReply, WRENCH_ORDER,
 };
 pub use wire::{Code, DecodeError, Flag};
 

@@ -410,16 +410,14 @@ pub struct SimTruth {
     pub actuators: ActuatorLoad,
 }
 
-/// Joint groups of [`ActuatorLoad`], in its arrays' order (`[robot.joint_groups]`).
-pub const JOINT_GROUPS: [&str; 4] = ["legs", "arms", "torso", "head"];
-
 /// The load of a simulated robot's motors since the simulator started, against the URDF's limits:
-/// whether a walk asked more of a motor than it has. Per joint group ([`JOINT_GROUPS`]) the peak
+/// whether a walk asked more of a motor than it has. Per joint group (legs, arms, torso, head:
+/// the order of `kinematics::robot::JointGroups::named`) the peak
 /// of `|τ| / effort limit` (sustained: |τ| low-passed over 20 ms, see walk-sim's
 /// `mujoco::actuators`) and of `|q̇| / velocity limit` over the group's joints (0 for an empty
 /// group or joints without a limit).
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
 #[type_name("walk.v4.ActuatorLoad")]
 pub struct ActuatorLoad {
     /// Peak sustained torque as a fraction of the effort limit, per joint group.

@@ -8,7 +8,7 @@ use std::fmt::Write;
 
 use kinematics::robot::Robot;
 use serde::{Serialize, Serializer};
-use shm_types::{ActuatorLoad, JOINT_GROUPS};
+use shm_types::ActuatorLoad;
 
 /// A joint at its torque limit for longer than this is flagged (s). Impacts saturate a motor for
 /// a few milliseconds; a tenth of a second is a motor that cannot carry what the walk asks.
@@ -33,17 +33,13 @@ pub struct ActuatorReport {
 impl ActuatorReport {
     /// `load` measured on `robot`.
     pub fn new(load: &ActuatorLoad, robot: &Robot) -> Self {
-        let g = &robot.joint_groups;
-        let present: Vec<usize> = [&g.legs, &g.arms, &g.torso, &g.head]
-            .iter()
-            .enumerate()
-            .filter(|(_, joints)| !joints.is_empty())
-            .map(|(i, _)| i)
-            .collect();
+        let named = robot.joint_groups.named();
         let by_group = |values: &[f64; 4]| {
-            present
+            named
                 .iter()
-                .map(|&i| (JOINT_GROUPS[i], values[i]))
+                .zip(values)
+                .filter(|((_, joints), _)| !joints.is_empty())
+                .map(|((group, _), &value)| (*group, value))
                 .collect()
         };
         Self {

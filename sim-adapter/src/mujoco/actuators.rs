@@ -15,20 +15,21 @@ use shm_types::ActuatorLoad;
 
 /// A joint counts as at its torque limit while its torque is at least this fraction of it
 /// (MuJoCo clamps to the limit exactly; the margin absorbs rounding).
-pub const AT_LIMIT_FRACTION: f64 = 0.99;
+const AT_LIMIT_FRACTION: f64 = 0.99;
 
 /// Time constant of the low-pass filter on |τ| whose peak is reported (s).
-pub const TORQUE_FILTER_S: f64 = 0.02;
+const TORQUE_FILTER_S: f64 = 0.02;
 
 /// The actuator record of a simulated robot; see the module docs. Allocation-free after
 /// construction.
 #[derive(Clone, Debug)]
-pub struct ActuatorRecord {
+pub(crate) struct ActuatorRecord {
     /// Effort and velocity limit of each joint (N·m or N, rad/s or m/s; infinite or 0: none in
     /// the URDF), model order.
     effort_limits: Vec<f64>,
     velocity_limits: Vec<f64>,
-    /// The index in [`shm_types::JOINT_GROUPS`] of each joint's group, if it has one.
+    /// The index in `JointGroups::named` (the load's array index) of each joint's group, if it
+    /// has one.
     groups: Vec<Option<usize>>,
     /// How long each joint has been at its torque limit now (s).
     at_limit_s: Vec<f64>,
@@ -43,13 +44,9 @@ impl ActuatorRecord {
     /// A record for `robot`'s joints, nothing seen yet.
     pub fn new(robot: &Robot) -> Self {
         let limits = robot.model.joint_limits();
-        let g = &robot.joint_groups;
+        let named = robot.joint_groups.named();
         let groups = (0..limits.len())
-            .map(|j| {
-                [&g.legs, &g.arms, &g.torso, &g.head]
-                    .iter()
-                    .position(|group| group.contains(&j))
-            })
+            .map(|j| named.iter().position(|(_, joints)| joints.contains(&j)))
             .collect();
         Self {
             effort_limits: limits.iter().map(|l| l.effort).collect(),

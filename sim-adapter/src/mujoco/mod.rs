@@ -22,7 +22,6 @@ pub mod render;
 mod sim;
 mod visuals;
 
-pub use actuators::{AT_LIMIT_FRACTION, ActuatorRecord};
 pub use error::MujocoError;
 pub use options::MujocoOptions;
 pub use sim::MujocoSim;
