@@ -29,18 +29,26 @@ impl SupportSurface {
     /// Elevation (world z) of the surface vertically below/above the world point `(x, y)`;
     /// `None` if that point projects outside the polygon or the surface is vertical.
     pub fn elevation_at(&self, x: f64, y: f64) -> Option<f64> {
+        let z = self.plane_elevation_at(x, y)?;
+        let Some(polygon) = &self.polygon else {
+            return Some(z);
+        };
+        let local = self.pose.inverse_transform_point(&Point3::new(x, y, z));
+        polygon_contains(polygon, local.x, local.y).then_some(z)
+    }
+
+    /// Elevation (world z) of the surface's plane, ignoring the polygon, vertically below/above
+    /// `(x, y)`; `None` if the surface is vertical. A scene measures the step between two
+    /// surfaces with it where the path crosses from one to the other, a point that may lie just
+    /// outside either polygon (they need only touch within a tolerance).
+    pub fn plane_elevation_at(&self, x: f64, y: f64) -> Option<f64> {
         let normal = self.pose.rotation * Vector3::z();
         if normal.z.abs() < 1e-9 {
             return None;
         }
         let origin = self.pose.translation.vector;
         // n · (p − o) = 0 with p = (x, y, z) solved for z.
-        let z = origin.z - (normal.x * (x - origin.x) + normal.y * (y - origin.y)) / normal.z;
-        let Some(polygon) = &self.polygon else {
-            return Some(z);
-        };
-        let local = self.pose.inverse_transform_point(&Point3::new(x, y, z));
-        polygon_contains(polygon, local.x, local.y).then_some(z)
+        Some(origin.z - (normal.x * (x - origin.x) + normal.y * (y - origin.y)) / normal.z)
     }
 }
 

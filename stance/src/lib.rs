@@ -8,6 +8,8 @@
 //!   reusable buffers.
 //! - [`generate()`]: a human-like, impeded stance source; `learned` (feature `learned`): the
 //!   n-gram model trained on human demonstrations.
+//! - [`Scene`] ([`scene`]): a versioned TOML scene file (surfaces, railings, start and goal),
+//!   validated strictly into an [`Environment`] and the walk's start and goal.
 //! - [`walk`]: a walk of a given distance (generated for `distance / scf`, then post-processed).
 //! - [`derived`]: step sizes, swing heights, orthogonal foot distances.
 //! - `plot` (feature `plot`): SVG figures of sequences.
@@ -30,6 +32,7 @@ mod pipeline;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod poses;
+pub mod scene;
 pub mod sequence;
 mod stance_ik;
 pub mod walk;
@@ -43,5 +46,6 @@ pub use geometry::PathFrame;
 pub use params::{ContactUnification, Gait, GaitUnavailable, ParamsError, PostProcessParams};
 pub use pipeline::PostProcessor;
 pub use poses::PoseSequence;
+pub use scene::{Scene, SceneError};
 pub use sequence::{PostProcessedSequence, RawSequence, Stance, StanceSequence};
 pub use walk::{WalkRequest, synthetic_walk};
