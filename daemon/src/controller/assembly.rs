@@ -17,7 +17,11 @@
 //!
 //! Tasks: CoM x/y (and z at a constant height in the dynamic gait, whose ZMP-feasible CoM
 //! set-point replaces the polygon constraint), end-effector poses, upright base, posture (the
-//! dynamic gait may weigh the torso joints' posture apart). Jacobian blocks are accumulated
+//! dynamic gait may weigh the torso joints' posture apart). The legs' posture reference is the
+//! standing posture, not the stance's `q_S`: the feet and CoM tasks place the legs, and `q_S`'s
+//! legs come from the post-processing IK, which may crouch to reach a held hand's target
+//! (JVRC-1's knees at 1.24 rad, where single support holds more than their 100 N·m; with it, the
+//! static gait's 5 m walks with a hand tipped in 4 of 20). Jacobian blocks are accumulated
 //! over their structurally non-zero columns only, so a foot task costs a few hundred flops.
 //! Everything is preallocated at construction.
 
@@ -51,6 +55,8 @@ pub(crate) struct QpAssembler {
     corners: [[f64; 2]; MAX_SUPPORT_POINTS],
     /// Whether each joint belongs to `[robot.joint_groups] torso`.
     torso_joints: Vec<bool>,
+    /// Whether each joint belongs to `[robot.joint_groups] legs`.
+    leg_joints: Vec<bool>,
 }
 
 impl QpAssembler {
@@ -100,6 +106,9 @@ impl QpAssembler {
             corners: [[0.0; 2]; MAX_SUPPORT_POINTS],
             torso_joints: (0..model.dof())
                 .map(|j| robot.joint_groups.torso.contains(&j))
+                .collect(),
+            leg_joints: (0..model.dof())
+                .map(|j| robot.joint_groups.legs.contains(&j))
                 .collect(),
         }
     }
@@ -207,13 +216,19 @@ impl QpAssembler {
             q[3 + k] -= config.torso_weight * config.torso_gain * tilt[k];
         }
 
-        // Posture (the torso joints at their own weight when the gait asks for it).
+        // Posture: the stance's, the legs' standing one, and the torso joints at their own
+        // weight when the gait asks for it.
         for j in 0..model.dof() {
             let weight = match targets.torso_posture_weight {
                 Some(weight) if self.torso_joints[j] => weight,
                 _ => config.posture_weight,
             };
-            let error = posture[j] - configuration.joints[j];
+            let reference = if self.leg_joints[j] {
+                robot.standing.joints[j]
+            } else {
+                posture[j]
+            };
+            let error = reference - configuration.joints[j];
             p[(6 + j, 6 + j)] += weight;
             q[6 + j] -= weight * config.posture_gain * error;
         }
@@ -357,5 +372,73 @@ fn add_task(
                 p[(cb, ca)] += weight * dot;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::controller::machine::StateMachine;
+    use kinematics::robot::SoleRectangle;
+
+    /// The linear term of the QP at the standing posture, with `posture` as the stance's `q_S`.
+    fn linear_term(
+        robot: &Robot,
+        config: &ControllerConfig,
+        posture: &DVector<f64>,
+    ) -> DVector<f64> {
+        let mut kinematics = Kinematics::new(&robot.model);
+        kinematics.update(&robot.model, &robot.standing);
+        let sole = SoleRectangle {
+            length: 0.2,
+            width: 0.08,
+        };
+        let machine = StateMachine::new(config, sole, 600.0);
+        let mut assembler = QpAssembler::new(robot);
+        assembler.assemble(
+            robot,
+            config,
+            &kinematics,
+            &robot.standing,
+            &robot.standing.joints,
+            machine.targets(),
+            posture,
+            0.002,
+        );
+        assembler.problem().q().into_owned()
+    }
+
+    #[test]
+    fn the_legs_posture_is_the_standing_one_and_the_arms_follow_the_stance() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/jvrc1.toml");
+        let robot = Robot::load(&path, None).expect("the JVRC-1 config loads");
+        let config = ControllerConfig::from_config_file(&path).expect("its [controller] loads");
+        let knee = robot
+            .model
+            .joint_index("R_KNEE")
+            .expect("JVRC-1 has R_KNEE");
+        let elbow = robot
+            .model
+            .joint_index("R_ELBOW_P")
+            .expect("JVRC-1 has R_ELBOW_P");
+        let standing = robot.standing.joints.clone();
+        let mut crouched = standing.clone();
+        crouched[knee] += 0.5;
+        crouched[elbow] -= 0.5;
+        let (a, b) = (
+            linear_term(&robot, &config, &standing),
+            linear_term(&robot, &config, &crouched),
+        );
+        assert_eq!(
+            a[6 + knee],
+            b[6 + knee],
+            "a stance's knee angle pulls the knee"
+        );
+        assert!(
+            (a[6 + elbow] - b[6 + elbow]).abs() > 1e-4,
+            "the stance's elbow angle does not pull the elbow"
+        );
     }
 }
