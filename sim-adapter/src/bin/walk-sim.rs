@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! walk-sim --config configs/armar4.toml --physics kinematic|mujoco [--clock realtime|lockstep]
-//!          [--rate-hz F] [--urdf PATH] [--service-prefix P] [--judge-by-zmp]
+//!          [--rate-hz F] [--urdf PATH] [--service-prefix P] [--judge-by-zmp] [--scene FILE]
 //!          [--snapshots DIR [--snapshot-period S] [--snapshot-lookat X,Y,Z]]
 //!          [--inject KIND [--inject-step K] [--inject-delay S]]
 //! ```
@@ -12,6 +12,9 @@
 //! With `--inject` (evaluation of the controlled stop, `sim_adapter::inject`) it reports one bad
 //! sample, withholds a touchdown or asks walkd for a hold or abort, `--inject-delay` seconds of
 //! simulated time after the `--inject-step`-th lift-off of a foot.
+//! With `--scene` (MuJoCo only) the world is the scene's terrain (docs/scenes.md,
+//! `sim_adapter::mujoco::Terrain`) instead of the flat floor, and the robot starts standing at the
+//! scene's start.
 //! With `--snapshots` (MuJoCo only, feature `render`) it saves a side view of the robot every
 //! `--snapshot-period` of simulated time (`sim_adapter::mujoco::render`).
 //! Besides the adapter side of the contract it publishes the simulator's ground truth (CoM,
@@ -66,6 +69,10 @@ struct Args {
     /// support polygon by design).
     #[arg(long)]
     judge_by_zmp: bool,
+    /// `--physics mujoco`: build the world from this scene file (docs/scenes.md) instead of the
+    /// flat floor, and stand the robot at the scene's start.
+    #[arg(long, value_name = "FILE")]
+    scene: Option<PathBuf>,
     /// `--physics mujoco`: save a picture of the robot (MuJoCo's offscreen renderer, EGL) every
     /// `--snapshot-period` of simulated time into this directory (needs --features
     /// sim-adapter/render).
@@ -151,6 +158,12 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
         Robot::from_config(&file, args.urdf.as_deref()).map_err(|e| config_error(e.into()))?;
     let robot = Arc::new(robot);
     match args.physics {
+        Physics::Kinematic if args.scene.is_some() => Err((
+            exit_code::USAGE,
+            anyhow::anyhow!(
+                "--scene needs --physics mujoco: the kinematic simulator does not model terrain yet"
+            ),
+        )),
         Physics::Kinematic => {
             let standing = robot.standing.clone();
             let options = SimOptions {
@@ -172,21 +185,36 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
     }
 }
 
-/// `--physics mujoco`: the robot standing in its configured posture under MuJoCo.
+/// `--physics mujoco`: the robot standing in its configured posture under MuJoCo, on the flat
+/// floor or at the start of the `--scene`.
 #[cfg(feature = "mujoco")]
 fn serve_mujoco(
     robot: Arc<Robot>,
     runtime: &RuntimeConfig,
     args: &Args,
 ) -> Result<(), (u8, anyhow::Error)> {
-    use sim_adapter::mujoco::{MujocoOptions, MujocoSim};
+    use sim_adapter::mujoco::{MujocoOptions, MujocoSim, Terrain};
+    let config_error = |e: anyhow::Error| (exit_code::CONFIG, e);
     let (urdf, standing) = (robot.urdf.clone(), robot.standing.clone());
-    let sim = MujocoSim::new(robot, &urdf, &standing, MujocoOptions::default()).map_err(|e| {
-        (
-            exit_code::CONFIG,
-            anyhow::Error::from(e).context("MuJoCo model"),
-        )
-    })?;
+    let options = MujocoOptions::default();
+    let sim = match &args.scene {
+        None => MujocoSim::new(robot, &urdf, &standing, options),
+        Some(path) => {
+            let scene = stance::Scene::from_path(path).map_err(|e| config_error(e.into()))?;
+            let terrain = Terrain::from_scene(&scene).map_err(|e| {
+                config_error(anyhow::Error::from(e).context(path.display().to_string()))
+            })?;
+            tracing::info!(
+                scene = scene.name,
+                surfaces = scene.environment.surfaces.len(),
+                railings = scene.railing_radii.len(),
+                "terrain"
+            );
+            let initial = terrain.place(&standing);
+            MujocoSim::on_terrain(robot, &urdf, &initial, options, terrain)
+        }
+    }
+    .map_err(|e| config_error(anyhow::Error::from(e).context("MuJoCo model")))?;
     match &args.snapshots {
         None => serve(runtime, args, SimulatedRobot::new(sim)),
         Some(dir) => serve_with_snapshots(runtime, args, sim, dir),

@@ -29,6 +29,10 @@ pub enum MujocoError {
     /// MuJoCo rejected the generated model.
     #[error("MuJoCo could not compile the generated model: {0}")]
     Compile(String),
+    /// A scene that cannot be turned into MuJoCo geometry (only a scene built by hand can be:
+    /// `stance::Scene::from_path` validates the rest).
+    #[error("terrain: {0}")]
+    BadTerrain(String),
     /// Drawing or saving a picture failed (feature `render`).
     #[error("rendering: {0}")]
     Render(String),

@@ -1,13 +1,16 @@
-//! Writes the MuJoCo model (MJCF) of a robot standing on a floor.
+//! Writes the MuJoCo model (MJCF) of a robot standing on a floor, or in a scene's terrain.
 //!
 //! Generated from the URDF's kinematics and inertials (see `bodies`) rather than loaded with
 //! MuJoCo's URDF importer, so no mesh is needed and every modelling choice is explicit:
-//! - a free joint on the base and an infinite floor plane at z = 0;
+//! - a free joint on the base and an infinite floor plane at z = 0 (with a [`Terrain`], the
+//!   plane at its base, and its surface boxes and railing capsules: see `terrain`);
 //! - one hinge/slide joint per actuated joint, with the URDF position limits, armature and
 //!   damping, and the URDF effort limit as the bound on its actuators' torque (motor
 //!   saturation; a URDF effort of 0 or none leaves it unbounded);
 //! - collision geometry only where contact is meaningful: one box per foot, the configured sole
 //!   rectangle with its bottom face on the sole frame, colliding with the floor and nothing else;
+//! - with a [`Terrain`], a capsule along each leg bone (below), colliding with the floor and the
+//!   terrain only;
 //! - sites at every end-effector frame, both FT frames and the base (the IMU);
 //! - per joint a position and a velocity actuator (the servo), in model joint order;
 //! - IMU sensors (orientation, gyro, accelerometer) at the base site;
@@ -15,6 +18,18 @@
 //!   visual-only geoms of the links in geom group [`VISUAL_GROUP`](super::visuals::VISUAL_GROUP)
 //!   (no collision: `contype` = `conaffinity` = 0 by default; no inertia: `inertiafromgeom` is
 //!   false), a floor texture, a sky and an offscreen buffer.
+//!
+//! Collision classes: the environment's geoms set `contype`, the robot's `conaffinity`, so the
+//! robot never collides with itself. Bit [`GROUND_BIT`]: the floor and the terrain's surfaces
+//! against the soles and the leg capsules. Bit [`RAILING_BIT`]: the railings, against nothing yet
+//! (hands get geometry with the hand issue).
+//!
+//! Leg bones: for each body moved by a `[robot.joint_groups] legs` joint, a capsule from its
+//! origin (the joint) to each child body's origin, [`leg_radius`] thick, hidden in geom group
+//! [`LEG_GROUP`] (the skeleton draws the legs). Bones shorter than
+//! [`kinematics::skeleton::MIN_SEGMENT`] (coincident axes of a hip or an ankle) are skipped, and
+//! the foot body has no child: the shin's capsule ends at the ankle, whose height above the sole
+//! (0.108 m on JVRC-1, 0.089 m on ARMAR-4) exceeds the radius, so flat ground never reaches it.
 
 use std::fmt::Write;
 
@@ -25,6 +40,7 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 use super::MujocoError;
 use super::bodies::{MassProperties, RigidBodies};
 use super::options::MujocoOptions;
+use super::terrain::Terrain;
 use super::visuals::{self, VisualGeom};
 
 /// Name of the floating base's free joint.
@@ -35,6 +51,24 @@ pub(crate) const IMU_SITE: &str = "imu";
 pub(crate) const FT_SITES: [&str; 2] = ["left_foot_ft", "right_foot_ft"];
 /// Geom names of the foot collision boxes (left, right).
 pub(crate) const FOOT_GEOMS: [&str; 2] = ["left_sole", "right_sole"];
+/// Collision bit of the ground: the floor and the terrain's surfaces (`contype`), the soles and
+/// the leg capsules (`conaffinity`).
+pub(crate) const GROUND_BIT: u32 = 1;
+/// Collision bit of the railings (`contype`); no robot geom has it in its `conaffinity` yet.
+pub(crate) const RAILING_BIT: u32 = 2;
+/// Geom group of the leg capsules: not drawn (MuJoCo draws groups 0–2 by default).
+pub(crate) const LEG_GROUP: u32 = 3;
+/// Name prefixes of the terrain's surface boxes, railing capsules and the leg capsules.
+pub(crate) const SURFACE_PREFIX: &str = "surface/";
+pub(crate) const RAILING_PREFIX: &str = "railing/";
+pub(crate) const LEG_PREFIX: &str = "leg/";
+/// Sliding friction of a railing: a hand's grip, whatever the soles' `friction` option.
+const RAILING_FRICTION: f64 = 1.0;
+/// The leg capsules' radius is this fraction of the sole width: a leg about as wide as its foot.
+const LEG_RADIUS_PER_SOLE_WIDTH: f64 = 0.5;
+/// Colours of the terrain in pictures.
+const SURFACE_RGBA: &str = "0.80 0.76 0.70 1";
+const RAILING_RGBA: &str = "0.55 0.35 0.20 1";
 /// Sensor data layout: base orientation quaternion (w, x, y, z), gyro, accelerometer.
 pub(crate) const IMU_QUAT: std::ops::Range<usize> = 0..4;
 pub(crate) const IMU_GYRO: std::ops::Range<usize> = 4..7;
@@ -45,11 +79,18 @@ pub(crate) fn end_effector_site(effector: EndEffector) -> &'static str {
     effector.name()
 }
 
-/// The MJCF document of `robot` built from `bodies`.
+/// Radius of the leg capsules of `robot` (m): half its sole width (0.04 m on JVRC-1, 0.062 m
+/// on ARMAR-4).
+fn leg_radius(robot: &Robot) -> f64 {
+    robot.sole.width * LEG_RADIUS_PER_SOLE_WIDTH
+}
+
+/// The MJCF document of `robot` built from `bodies`, on the flat floor or in `terrain`.
 pub(crate) fn write(
     robot: &Robot,
     bodies: &RigidBodies,
     options: &MujocoOptions,
+    terrain: Option<&Terrain>,
 ) -> Result<String, MujocoError> {
     let mut xml = String::with_capacity(64 * 1024);
     let o = options;
@@ -81,17 +122,25 @@ pub(crate) fn write(
         xml.push_str(&visuals::scene());
     }
     let _ = writeln!(xml, "  <worldbody>");
-    // The floor collides with whatever has conaffinity 1: only the feet.
+    // The floor collides with whatever has conaffinity 1: the feet (and the leg capsules).
     let floor_material = if o.visual_geoms {
         visuals::FLOOR_MATERIAL
     } else {
         ""
     };
+    let floor_position = match terrain {
+        None => String::new(),
+        Some(terrain) => format!(r#" pos="0 0 {}""#, terrain.base()),
+    };
     let _ = writeln!(
         xml,
-        r#"    <geom name="floor" type="plane" size="0 0 1" contype="1"{floor_material}/>"#
+        r#"    <geom name="floor" type="plane" size="0 0 1"{floor_position} contype="{GROUND_BIT}"{floor_material}/>"#
     );
     let mut attachments = Attachments::collect(robot, bodies, o.sole_thickness)?;
+    if let Some(terrain) = terrain {
+        write_terrain(&mut xml, terrain);
+        attachments.add_leg_bones(robot, bodies);
+    }
     if o.visual_geoms {
         attachments.add_visuals(robot, bodies)?;
     }
@@ -124,6 +173,31 @@ pub(crate) fn write(
     Ok(xml)
 }
 
+/// The static geoms of `terrain` in the worldbody: a box per surface, a capsule per railing.
+fn write_terrain(xml: &mut String, terrain: &Terrain) {
+    for surface in terrain.boxes() {
+        let h = &surface.half;
+        let _ = writeln!(
+            xml,
+            r#"    <geom name="{SURFACE_PREFIX}{}" type="box" size="{} {} {}" {} contype="{GROUND_BIT}" rgba="{SURFACE_RGBA}"/>"#,
+            escape(&surface.name),
+            h.x,
+            h.y,
+            h.z,
+            pose_attributes(&surface.pose)
+        );
+    }
+    for railing in terrain.railings() {
+        let _ = writeln!(
+            xml,
+            r#"    <geom name="{RAILING_PREFIX}{}" type="capsule" size="{}" {} contype="{RAILING_BIT}" friction="{RAILING_FRICTION} 0.005 0.0001" rgba="{RAILING_RGBA}"/>"#,
+            escape(&railing.name),
+            railing.radius,
+            fromto(&railing.from, &railing.to)
+        );
+    }
+}
+
 /// A site or geom hung on a rigid body.
 struct Attachment {
     body: usize,
@@ -135,6 +209,13 @@ enum AttachmentKind {
     Site(&'static str),
     /// A foot collision box: (name, half extents).
     SoleBox(&'static str, Vector3<f64>),
+    /// A leg bone's collision capsule from the body origin to `end`, in the body frame (the
+    /// attachment pose is unused).
+    LegBone {
+        name: String,
+        end: Vector3<f64>,
+        radius: f64,
+    },
     /// A visual-only geom (its pose is in the geom; the attachment pose is unused).
     Visual(VisualGeom),
 }
@@ -183,6 +264,32 @@ impl Attachments {
             });
         }
         Ok(Self(all))
+    }
+
+    /// Adds a collision capsule along each bone of the legs (see the module docs).
+    fn add_leg_bones(&mut self, robot: &Robot, bodies: &RigidBodies) {
+        let radius = leg_radius(robot);
+        let legs = &robot.joint_groups.legs;
+        for (index, body) in bodies.bodies.iter().enumerate() {
+            if !body.joint.as_ref().is_some_and(|j| legs.contains(&j.index)) {
+                continue;
+            }
+            for child in bodies.bodies.iter().filter(|c| c.parent == Some(index)) {
+                let end = child.origin.translation.vector;
+                if end.norm() < kinematics::skeleton::MIN_SEGMENT {
+                    continue;
+                }
+                self.0.push(Attachment {
+                    body: index,
+                    pose: Isometry3::identity(),
+                    kind: AttachmentKind::LegBone {
+                        name: format!("{LEG_PREFIX}{}/{}", body.name, child.name),
+                        end,
+                        radius,
+                    },
+                });
+            }
+        }
     }
 
     /// Adds the visual-only geoms of every link's skeleton shapes.
@@ -293,6 +400,18 @@ fn write_body(
                     pose_attributes(&attachment.pose)
                 );
             }
+            AttachmentKind::LegBone {
+                ref name,
+                end,
+                radius,
+            } => {
+                let _ = writeln!(
+                    xml,
+                    r#"{pad}  <geom name="{}" type="capsule" size="{radius}" {} conaffinity="{GROUND_BIT}" group="{LEG_GROUP}"/>"#,
+                    escape(name),
+                    fromto(&Vector3::zeros(), &end)
+                );
+            }
             AttachmentKind::Visual(ref geom) => {
                 let _ = writeln!(xml, "{pad}  {}", geom.element());
             }
@@ -353,10 +472,106 @@ fn pose_attributes(pose: &Isometry3<f64>) -> String {
     )
 }
 
+/// The `fromto` attribute of a capsule, full precision.
+fn fromto(from: &Vector3<f64>, to: &Vector3<f64>) -> String {
+    format!(
+        r#"fromto="{} {} {} {} {} {}""#,
+        from.x, from.y, from.z, to.x, to.y, to.z
+    )
+}
+
 /// Escapes a name for an XML attribute value.
 fn escape(name: &str) -> String {
     name.replace('&', "&amp;")
         .replace('"', "&quot;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::{Path, PathBuf};
+
+    fn configs() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs")
+    }
+
+    fn model(name: &str) -> (Robot, RigidBodies) {
+        let robot = Robot::load(&configs().join(format!("{name}.toml")), None).unwrap();
+        let urdf = urdf_rs::read_file(&robot.urdf).unwrap();
+        let bodies = RigidBodies::from_urdf(&urdf, &robot.model).unwrap();
+        (robot, bodies)
+    }
+
+    /// FNV-1a, 64 bits: a fingerprint of a document that does not depend on the Rust release.
+    fn fingerprint(text: &str) -> u64 {
+        text.bytes().fold(0xcbf2_9ce4_8422_2325, |hash, byte| {
+            (hash ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3)
+        })
+    }
+
+    #[test]
+    fn without_a_terrain_the_model_is_the_flat_floor_one() {
+        // Fingerprints and lengths of the documents written before terrain existed: flat walks
+        // simulate the same model as then.
+        for (name, visual_geoms, hash, length) in [
+            ("jvrc1", true, 0xf8c7_5ae0_ad90_45b8, 23057),
+            ("jvrc1", false, 0x58e2_14e4_fe88_b33c, 18344),
+            ("armar4", true, 0x6b8e_868a_fcae_04e6, 24546),
+            ("armar4", false, 0x4e47_2ea1_3357_23e1, 18853),
+        ] {
+            let (robot, bodies) = model(name);
+            let options = MujocoOptions {
+                visual_geoms,
+                ..MujocoOptions::default()
+            };
+            let xml = write(&robot, &bodies, &options, None).unwrap();
+            assert_eq!(
+                (fingerprint(&xml), xml.len()),
+                (hash, length),
+                "{name}, visual geoms {visual_geoms}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_terrain_adds_its_geoms_and_the_leg_bones() {
+        let (robot, bodies) = model("jvrc1");
+        let scene = stance::Scene::from_path(&configs().join("scenes/railing.toml")).unwrap();
+        let terrain = Terrain::from_scene(&scene).unwrap();
+        let options = MujocoOptions::default();
+        let xml = write(&robot, &bodies, &options, Some(&terrain)).unwrap();
+        let flat = write(&robot, &bodies, &options, None).unwrap();
+        let added: Vec<&str> = xml.lines().filter(|l| !flat.contains(*l)).collect();
+        let floor = format!(
+            r#"    <geom name="floor" type="plane" size="0 0 1" pos="0 0 -{}" contype="1" material="grid"/>"#,
+            super::super::DEPTH_BELOW
+        );
+        assert_eq!(added[0], floor);
+        assert!(added[1].contains(r#"name="surface/ground" type="box" size="4 1.5 0.025""#));
+        assert!(added[2].contains(r#"name="railing/railing" type="capsule" size="0.02""#));
+        assert!(added[2].contains(r#"contype="2" friction="1 0.005 0.0001""#));
+        // Per leg: the thigh (hip to knee) and the shin (knee to ankle); the hips' and ankles'
+        // coincident axes give no bone.
+        let bones: Vec<&str> = added[3..]
+            .iter()
+            .map(|l| l.trim().split('"').nth(1).unwrap())
+            .collect();
+        assert_eq!(
+            bones,
+            [
+                "leg/R_HIP_Y_S/R_KNEE_S",
+                "leg/R_KNEE_S/R_ANKLE_R_S",
+                "leg/L_HIP_Y_S/L_KNEE_S",
+                "leg/L_KNEE_S/L_ANKLE_R_S"
+            ]
+        );
+        for line in &added[3..] {
+            assert!(
+                line.contains(r#"size="0.04""#) && line.contains(r#"conaffinity="1" group="3""#),
+                "{line}"
+            );
+        }
+    }
 }

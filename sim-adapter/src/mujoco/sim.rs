@@ -13,9 +13,10 @@ use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuat
 
 use super::actuators::ActuatorRecord;
 use super::bodies::RigidBodies;
+use super::collisions::{CollisionWatch, TerrainCollisions};
 use super::contact::{self, FootContacts, FootIds};
 use super::mjcf;
-use super::{MujocoError, MujocoOptions};
+use super::{MujocoError, MujocoOptions, Terrain};
 
 /// The MuJoCo version mujoco-rs 7.0.0 is built for (it refuses any other).
 const MUJOCO_VERSION: &str = "3.17.0";
@@ -44,7 +45,8 @@ struct Layout {
     base_link_offset: Isometry3<f64>,
 }
 
-/// A robot standing on a flat floor under MuJoCo's rigid-body dynamics, driven by joint servos.
+/// A robot standing on a flat floor, or in a scene's [`Terrain`], under MuJoCo's rigid-body
+/// dynamics, driven by joint servos.
 ///
 /// Deterministic: the same robot, options, initial state and commands give bit-identical states.
 /// Not real-time safe to construct (it compiles a model); [`MujocoSim::step`] does not allocate.
@@ -67,16 +69,43 @@ pub struct MujocoSim {
     actuators: ActuatorRecord,
     /// Each servo's position reference over the current command period: from, to.
     servo_ramps: Vec<(f64, f64)>,
+    /// The scene the robot is in (`None`: the flat floor).
+    terrain: Option<Terrain>,
+    /// Leg contacts with the terrain other than the soles'.
+    collisions: CollisionWatch,
 }
 
 impl MujocoSim {
     /// Builds the physics model of `robot` (kinematics and inertials from `urdf`, the file the
-    /// robot was loaded from) and places it in `initial`, at rest.
+    /// robot was loaded from) on the flat floor and places it in `initial`, at rest.
     pub fn new(
         robot: Arc<Robot>,
         urdf: &Path,
         initial: &Configuration,
         options: MujocoOptions,
+    ) -> Result<Self, MujocoError> {
+        Self::build(robot, urdf, initial, options, None)
+    }
+
+    /// Like [`MujocoSim::new`], in `terrain` instead of on the flat floor, with collision
+    /// capsules on the legs; `initial` is in the world (see [`Terrain::place`] for the scene's
+    /// start).
+    pub fn on_terrain(
+        robot: Arc<Robot>,
+        urdf: &Path,
+        initial: &Configuration,
+        options: MujocoOptions,
+        terrain: Terrain,
+    ) -> Result<Self, MujocoError> {
+        Self::build(robot, urdf, initial, options, Some(terrain))
+    }
+
+    fn build(
+        robot: Arc<Robot>,
+        urdf: &Path,
+        initial: &Configuration,
+        options: MujocoOptions,
+        terrain: Option<Terrain>,
     ) -> Result<Self, MujocoError> {
         check_library_version()?;
         options.check()?;
@@ -96,10 +125,11 @@ impl MujocoSim {
             message: error.to_string(),
         })?;
         let bodies = RigidBodies::from_urdf(&parsed, &robot.model)?;
-        let xml = mjcf::write(&robot, &bodies, &options)?;
+        let xml = mjcf::write(&robot, &bodies, &options, terrain.as_ref())?;
         let model = MjModel::from_xml_string(&xml)
             .map_err(|error| MujocoError::Compile(error.to_string()))?;
         let layout = Layout::resolve(&model, &robot, &bodies)?;
+        let collisions = CollisionWatch::new(&model);
         let data = MjData::new(Box::new(model));
         let measurement = SimMeasurement::at_rest(initial, Vector3::zeros());
         let actuators = ActuatorRecord::new(&robot);
@@ -118,15 +148,23 @@ impl MujocoSim {
             commanded_time: 0.0,
             actuators,
             servo_ramps: vec![(0.0, 0.0); dof],
+            terrain,
+            collisions,
         };
         sim.place(initial);
-        sim.initial_base_height = sim.base_link_pose().translation.z;
+        sim.initial_base_height = sim.base_height();
         Ok(sim)
     }
 
     /// The options the model was built with.
     pub fn options(&self) -> &MujocoOptions {
         &self.options
+    }
+
+    /// The legs' contacts with the terrain other than the soles' since the start (always none
+    /// on the flat floor, where the legs have no collision geometry).
+    pub fn terrain_collisions(&self) -> &TerrainCollisions {
+        self.collisions.record()
     }
 
     /// The compiled MuJoCo model (e.g. to count its geoms or build a renderer for it).
@@ -150,9 +188,15 @@ impl MujocoSim {
         )
     }
 
-    /// Height of the `base_link` origin above the floor (m).
+    /// Height of the `base_link` origin above the floor, or above the terrain straight under it
+    /// ([`Terrain::elevation_at`]) (m).
     pub fn base_height(&self) -> f64 {
-        self.base_link_pose().translation.z
+        let base = self.base_link_pose().translation.vector;
+        let ground = self
+            .terrain
+            .as_ref()
+            .map_or(0.0, |terrain| terrain.elevation_at(base.x, base.y));
+        base.z - ground
     }
 
     /// Angle between the `base_link` z axis and the world vertical (rad).
@@ -194,6 +238,7 @@ impl MujocoSim {
         }
         self.data.forward();
         self.contacts = contact::read(&self.data, &self.layout.feet);
+        self.collisions.observe(&self.data, self.data.time());
         self.record(0);
     }
 
@@ -413,6 +458,7 @@ impl Simulator for MujocoSim {
                 ctrl[2 * j] = from + (to - from) * along;
             }
             // Forward dynamics of the current state, the constraint solve and the integration.
+            let time = self.data.time();
             self.data.step2();
             let (torques, speeds) = (self.data.qfrc_actuator(), self.data.qvel());
             let dofs = &self.layout.joint_dof;
@@ -422,6 +468,7 @@ impl Simulator for MujocoSim {
                 self.options.timestep,
             );
             // The contact list, solved forces and poses still describe the same state here.
+            self.collisions.observe(&self.data, time);
             if self.options.average_ft_over_step {
                 let reading = contact::read(&self.data, &self.layout.feet);
                 period.add(&reading, 1.0 / substeps as f64);
@@ -479,5 +526,47 @@ impl Simulator for MujocoSim {
 
     fn time(&self) -> f64 {
         self.data.time()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// Lowest point of each leg capsule above the lower sole, standing in the configured posture
+    /// on the flat ground of the railing scene (m).
+    fn leg_clearances(name: &str) -> Vec<f64> {
+        let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs");
+        let robot = Arc::new(Robot::load(&configs.join(format!("{name}.toml")), None).unwrap());
+        let scene = stance::Scene::from_path(&configs.join("scenes/railing.toml")).unwrap();
+        let terrain = Terrain::from_scene(&scene).unwrap();
+        let (urdf, initial) = (robot.urdf.clone(), terrain.place(&robot.standing));
+        let sim = MujocoSim::on_terrain(robot, &urdf, &initial, MujocoOptions::default(), terrain)
+            .unwrap();
+        let sole = FEET
+            .map(|foot| sim.end_effector_pose(foot).translation.z)
+            .into_iter()
+            .fold(f64::INFINITY, f64::min);
+        let (model, data) = (sim.model(), &sim.data);
+        (0..model.ngeom() as usize)
+            .filter(|&g| sim.collisions.is_leg(g))
+            .map(|g| {
+                // A capsule's axis is its frame's z; size = (radius, half length).
+                let [radius, half, _] = model.geom_size()[g];
+                let axis_z = data.geom_xmat()[g][8];
+                data.geom_xpos()[g][2] - axis_z.abs() * half - radius - sole
+            })
+            .collect()
+    }
+
+    #[test]
+    fn standing_legs_clear_the_ground() {
+        for (name, expected) in [("jvrc1", 0.0677), ("armar4", 0.0269)] {
+            let clearances = leg_clearances(name);
+            assert_eq!(clearances.len(), 4, "{name}: two bones a leg");
+            let lowest = clearances.iter().copied().fold(f64::INFINITY, f64::min);
+            assert!((lowest - expected).abs() < 1e-3, "{name}: {clearances:?}");
+        }
     }
 }

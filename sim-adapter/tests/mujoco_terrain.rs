@@ -1,0 +1,206 @@
+//! The MuJoCo world built from a scene (`sim_adapter::mujoco::Terrain`): every committed scene
+//! compiles into a box per surface and a capsule per railing; the robot stands at a scene's start
+//! as it does on the flat floor, with no leg touching the terrain; a shin driven into a stair's
+//! nosing is counted and named.
+//! Needs the `mujoco` feature (and the library: `eval "$(scripts/setup-mujoco.sh)"`).
+#![cfg(feature = "mujoco")]
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use kinematic_sim::Simulator;
+use kinematics::configuration::Configuration;
+use kinematics::robot::Robot;
+use mujoco_rs::prelude::MjtObjBase;
+use nalgebra::Translation3;
+use sim_adapter::mujoco::{MujocoOptions, MujocoSim, Terrain};
+use stance::Scene;
+
+/// Control period (500 Hz, as walkd runs).
+const DT: f64 = 0.002;
+
+fn configs() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs")
+}
+
+fn robot(name: &str) -> Arc<Robot> {
+    let config = configs().join(format!("{name}.toml"));
+    Arc::new(Robot::load(&config, None).unwrap_or_else(|e| panic!("{name}: {e}")))
+}
+
+fn terrain(scene: &str) -> Terrain {
+    let scene = Scene::from_path(&configs().join("scenes").join(scene)).unwrap();
+    Terrain::from_scene(&scene).unwrap()
+}
+
+/// `robot` in `terrain`, standing in `initial` (world).
+fn sim_on(robot: &Arc<Robot>, terrain: Terrain, initial: &Configuration) -> MujocoSim {
+    let urdf = robot.urdf.clone();
+    MujocoSim::on_terrain(
+        robot.clone(),
+        &urdf,
+        initial,
+        MujocoOptions::default(),
+        terrain,
+    )
+    .unwrap()
+}
+
+/// Names of the model's geoms starting with `prefix`.
+fn geoms_named(sim: &MujocoSim, prefix: &str) -> Vec<String> {
+    let model = sim.model();
+    (0..model.ngeom() as usize)
+        .filter_map(|g| model.id_to_name(MjtObjBase::mjOBJ_GEOM, g))
+        .filter(|name| name.starts_with(prefix))
+        .map(str::to_owned)
+        .collect()
+}
+
+#[test]
+fn every_committed_scene_builds_a_box_per_surface_and_a_capsule_per_railing() {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(configs().join("scenes"))
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .filter(|path| path.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 9, "{files:?}");
+    for name in ["jvrc1", "armar4"] {
+        let robot = robot(name);
+        for file in &files {
+            let scene = Scene::from_path(file).unwrap();
+            let terrain = Terrain::from_scene(&scene).unwrap();
+            let sim = sim_on(&robot, terrain.clone(), &terrain.place(&robot.standing));
+            let surfaces: Vec<String> = scene
+                .environment
+                .surfaces
+                .iter()
+                .map(|s| format!("surface/{}", s.name))
+                .collect();
+            assert_eq!(geoms_named(&sim, "surface/"), surfaces, "{name} {file:?}");
+            let railings = geoms_named(&sim, "railing/");
+            let expected = usize::from(scene.name == "railing");
+            assert_eq!(railings.len(), expected, "{name} {file:?}");
+            assert_eq!(geoms_named(&sim, "leg/").len(), 4, "{name} {file:?}");
+            assert_eq!(sim.terrain_collisions().count, 0, "{name} {file:?}");
+        }
+    }
+}
+
+/// Largest difference (m) between the base heights of `robot` standing still for 2 s at the
+/// start of `scene` and on the flat floor, and the terrain collisions counted.
+fn stand_at_start(name: &str, scene: &str) -> (f64, u64) {
+    let robot = robot(name);
+    let terrain = terrain(scene);
+    let initial = terrain.place(&robot.standing);
+    let mut on_terrain = sim_on(&robot, terrain, &initial);
+    let urdf = robot.urdf.clone();
+    let mut flat = MujocoSim::new(
+        robot.clone(),
+        &urdf,
+        &robot.standing,
+        MujocoOptions::default(),
+    )
+    .unwrap();
+    let q: Vec<f64> = robot.standing.joints.iter().copied().collect();
+    let qd = vec![0.0; q.len()];
+    let mut worst = (on_terrain.base_height() - flat.base_height()).abs();
+    for _ in 0..1000 {
+        on_terrain.step(&q, &qd, DT).unwrap();
+        flat.step(&q, &qd, DT).unwrap();
+        worst = worst.max((on_terrain.base_height() - flat.base_height()).abs());
+    }
+    assert!(!on_terrain.summary().fell, "{name} on {scene}: fell");
+    assert_eq!(
+        on_terrain.measurement().contacts,
+        [true, true, false, false],
+        "{name} on {scene}: both feet and only the feet touch"
+    );
+    (worst, on_terrain.terrain_collisions().count)
+}
+
+#[test]
+fn the_robot_stands_at_a_scenes_start_as_on_the_flat_floor() {
+    // The start on the floor (z = 0) before stairs and a ramp, and on the top landing (z = 1.85)
+    // of the stairs down: the base height is measured from the surface under the base.
+    for (name, scene) in [
+        ("jvrc1", "stairs-up-10cm.toml"),
+        ("jvrc1", "stairs-down-18cm.toml"),
+        ("jvrc1", "ramp-15deg.toml"),
+        ("armar4", "stairs-up-10cm.toml"),
+    ] {
+        let (height_error, collisions) = stand_at_start(name, scene);
+        assert!(
+            height_error < 0.01,
+            "{name} on {scene}: base height {height_error} m off the flat floor's"
+        );
+        assert_eq!(
+            collisions, 0,
+            "{name} on {scene}: the legs touched the terrain"
+        );
+    }
+}
+
+/// JVRC-1 on the 18.5 cm stairs, its soles' midpoint `to_riser` metres before the first riser,
+/// squats in 1.5 s to hip, knee and ankle pitch angles of -1, 2, -1 rad and holds 0.5 s. Returns
+/// the simulator.
+fn squat_before_the_stairs(to_riser: f64) -> MujocoSim {
+    let robot = robot("jvrc1");
+    let terrain = terrain("stairs-up-18cm.toml");
+    let mut initial = terrain.place(&robot.standing);
+    let riser = 1.5;
+    let shift = riser - to_riser - terrain.scene().start.translation.x;
+    initial.base = Translation3::new(shift, 0.0, 0.0) * initial.base;
+    let mut sim = sim_on(&robot, terrain, &initial);
+    let standing: Vec<f64> = robot.standing.joints.iter().copied().collect();
+    let mut squat = standing.clone();
+    for (joint, angle) in [("HIP_P", -1.0), ("KNEE", 2.0), ("ANKLE_P", -1.0)] {
+        for side in ["L", "R"] {
+            let index = robot.model.joint_index(&format!("{side}_{joint}")).unwrap();
+            squat[index] = angle;
+        }
+    }
+    let qd = vec![0.0; standing.len()];
+    let steps = (1.5 / DT) as usize;
+    for k in 0..steps + (0.5 / DT) as usize {
+        // Half-cosine from standing to the squat, then held.
+        let s = (0.5
+            - 0.5 * (std::f64::consts::PI * (k + 1).min(steps) as f64 / steps as f64).cos())
+        .min(1.0);
+        let q: Vec<f64> = standing
+            .iter()
+            .zip(&squat)
+            .map(|(a, b)| a + (b - a) * s)
+            .collect();
+        sim.step(&q, &qd, DT).unwrap();
+    }
+    sim
+}
+
+#[test]
+fn a_shin_driven_into_a_nosing_is_counted_and_named() {
+    // The toes 5 mm before the riser (the sole is 0.20 m long): the shin axis (knee to ankle)
+    // leans 0.89 rad forward, so each shin capsule (radius 0.04 m, from the ankle 0.135 m behind
+    // the riser and 0.108 m up) reaches about 1.5 cm into the first tread's nosing (0.185 m up).
+    let hit = squat_before_the_stairs(0.105);
+    let collisions = hit.terrain_collisions();
+    assert!(collisions.count >= 2, "{collisions:?}");
+    let mut shins: Vec<&str> = collisions.first.iter().map(|c| &*c.link).collect();
+    shins.sort();
+    shins.dedup();
+    assert_eq!(shins, ["L_KNEE_S", "R_KNEE_S"], "{collisions:?}");
+    assert!(
+        collisions.first.iter().all(|c| &*c.surface == "tread-1"),
+        "{collisions:?}"
+    );
+    // The same squat 1 m before the riser touches nothing.
+    let clear = squat_before_the_stairs(1.0);
+    assert_eq!(
+        clear.terrain_collisions().count,
+        0,
+        "{:?}",
+        clear.terrain_collisions()
+    );
+    // ... and stays upright (the squat itself is stable: the pelvis only goes down).
+    assert!(clear.torso_tilt() < 0.02, "tilt {} rad", clear.torso_tilt());
+}
