@@ -141,8 +141,12 @@ fn main() -> ExitCode {
     }
 }
 
+/// A bad config, URDF, scene or model: exit code [`exit_code::CONFIG`].
+fn config_error(error: anyhow::Error) -> (u8, anyhow::Error) {
+    (exit_code::CONFIG, error)
+}
+
 fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
-    let config_error = |e: anyhow::Error| (exit_code::CONFIG, e);
     let file = ConfigFile::load(&args.config).map_err(|e| config_error(e.into()))?;
     let runtime = RuntimeConfig::from_section(file.section("runtime"), &file.origin())
         .map_err(|e| config_error(e.into()))?;
@@ -194,7 +198,6 @@ fn serve_mujoco(
     args: &Args,
 ) -> Result<(), (u8, anyhow::Error)> {
     use sim_adapter::mujoco::{MujocoOptions, MujocoSim, Terrain};
-    let config_error = |e: anyhow::Error| (exit_code::CONFIG, e);
     let (urdf, standing) = (robot.urdf.clone(), robot.standing.clone());
     let options = MujocoOptions::default();
     let sim = match &args.scene {

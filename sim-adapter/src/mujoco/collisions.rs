@@ -43,10 +43,10 @@ pub(crate) struct CollisionWatch {
     terrain_of_geom: Vec<Option<Arc<str>>>,
     /// Link of each leg capsule.
     leg_links: Vec<Arc<str>>,
-    /// What each leg capsule touched in the last observed step, if anything.
-    touching: Vec<Option<Arc<str>>>,
+    /// The terrain geom each leg capsule touched in the last observed step, if any.
+    touching: Vec<Option<usize>>,
     /// The same for the step being observed.
-    now: Vec<Option<Arc<str>>>,
+    now: Vec<Option<usize>>,
     record: TerrainCollisions,
 }
 
@@ -100,12 +100,12 @@ impl CollisionWatch {
                 (None, Some(leg)) => (leg, a),
                 _ => continue,
             };
-            if let Some(surface) = &self.terrain_of_geom[other] {
-                self.now[leg].get_or_insert_with(|| Arc::clone(surface));
+            if self.terrain_of_geom[other].is_some() {
+                self.now[leg].get_or_insert(other);
             }
         }
         for (leg, (now, before)) in self.now.iter().zip(&self.touching).enumerate() {
-            let (Some(surface), None) = (now, before) else {
+            let (Some(terrain), None) = (now, before) else {
                 continue;
             };
             self.record.count += 1;
@@ -113,7 +113,9 @@ impl CollisionWatch {
                 self.record.first.push(TerrainCollision {
                     time_s,
                     link: Arc::clone(&self.leg_links[leg]),
-                    surface: Arc::clone(surface),
+                    surface: self.terrain_of_geom[*terrain]
+                        .clone()
+                        .expect("a terrain geom"),
                 });
             }
         }

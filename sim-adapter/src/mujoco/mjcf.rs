@@ -187,13 +187,12 @@ fn write_terrain(xml: &mut String, terrain: &Terrain) {
             pose_attributes(&surface.pose)
         );
     }
-    for railing in terrain.railings() {
+    for (railing, radius) in terrain.railings() {
         let _ = writeln!(
             xml,
-            r#"    <geom name="{RAILING_PREFIX}{}" type="capsule" size="{}" {} contype="{RAILING_BIT}" friction="{RAILING_FRICTION} 0.005 0.0001" rgba="{RAILING_RGBA}"/>"#,
+            r#"    <geom name="{RAILING_PREFIX}{}" type="capsule" size="{radius}" {} contype="{RAILING_BIT}" friction="{RAILING_FRICTION} 0.005 0.0001" rgba="{RAILING_RGBA}"/>"#,
             escape(&railing.name),
-            railing.radius,
-            fromto(&railing.from, &railing.to)
+            fromto(&railing.start, &railing.end)
         );
     }
 }

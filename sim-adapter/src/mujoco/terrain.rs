@@ -17,6 +17,7 @@
 
 use kinematics::configuration::Configuration;
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use stance::environment::HandAffordance;
 use stance::{Scene, SupportSurface};
 
 use super::MujocoError;
@@ -34,21 +35,11 @@ pub(crate) struct TerrainBox {
     pub half: Vector3<f64>,
 }
 
-/// A railing as a capsule: its name, the ends of its axis and its radius (m).
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct RailingCapsule {
-    pub name: String,
-    pub from: Vector3<f64>,
-    pub to: Vector3<f64>,
-    pub radius: f64,
-}
-
 /// The MuJoCo geometry of a scene, and where the robot starts in it; see the module docs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Terrain {
     scene: Scene,
     boxes: Vec<TerrainBox>,
-    railings: Vec<RailingCapsule>,
     base: f64,
 }
 
@@ -103,21 +94,9 @@ impl Terrain {
                 }
             })
             .collect();
-        let railings = environment
-            .hand_affordances
-            .iter()
-            .zip(&scene.railing_radii)
-            .map(|(railing, &radius)| RailingCapsule {
-                name: railing.name.clone(),
-                from: railing.start,
-                to: railing.end,
-                radius,
-            })
-            .collect();
         Ok(Self {
             scene: scene.clone(),
             boxes,
-            railings,
             base,
         })
     }
@@ -159,9 +138,14 @@ impl Terrain {
         &self.boxes
     }
 
-    /// The railings as capsules, in the scene's order.
-    pub(crate) fn railings(&self) -> &[RailingCapsule] {
-        &self.railings
+    /// The railings, each with its radius (a capsule along its segment), in the scene's order.
+    pub(crate) fn railings(&self) -> impl Iterator<Item = (&HandAffordance, f64)> {
+        let scene = &self.scene;
+        scene
+            .environment
+            .hand_affordances
+            .iter()
+            .zip(scene.railing_radii.iter().copied())
     }
 }
 
