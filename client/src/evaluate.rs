@@ -10,7 +10,10 @@
 //! - success: the daemon reports `done` and the simulator's fall rule never fired;
 //! - drift: the largest distance between the controller's CoM / sole estimate in a status and
 //!   the simulator's truth of the state that status's tick saw ([`truth::state_at`]);
-//! - final position error: the simulated soles' distance from their final targets.
+//! - final position error: the simulated soles' distance from their final targets;
+//! - steps and footholds ([`footholds`]): touchdowns of the simulated soles, their distance from
+//!   the planned footholds, the soles' elevation at the start and end, the legs' terrain
+//!   collisions; on a scene a walk must also land within [`footholds::FOOTHOLD_BOUND_M`] of them.
 //!
 //! `--inject FAULTS` injects each fault into every walk at each `--inject-at` moment of a single
 //! support (walk-sim's fault injection) and judges the stop instead of the walk ([`stop`]).
@@ -23,6 +26,7 @@ pub mod actuators;
 pub(crate) mod balance;
 pub mod fig6;
 pub mod filmstrip;
+pub mod footholds;
 pub mod record;
 pub mod stop;
 pub(crate) mod truth;
@@ -30,6 +34,7 @@ pub(crate) mod watch;
 
 use actuators::ActuatorReport;
 pub use fig6::{BalanceSample, write_fig6};
+use footholds::{PlannedFootholds, StepReport};
 pub use record::{GroupSummary, MatrixCells, WalkRecord, group_by_cell, speed_cell};
 
 use std::fmt::Write as _;
@@ -227,6 +232,8 @@ pub struct RunResult {
     pub balance: Vec<BalanceSample>,
     /// With an injected fault: how the walk stopped (it decides `record.success`).
     pub stop: Option<StopReport>,
+    /// Steps, footholds, elevations and terrain collisions from the simulator's truth.
+    pub steps: StepReport,
 }
 
 impl RunResult {
@@ -252,6 +259,13 @@ impl RunResult {
             "walked_m": r.walked_m,
             "speed_m_s": r.speed_m_s,
             "actuators": r.actuators,
+            "start_elevation_m": self.steps.start_elevation_m,
+            "end_elevation_m": self.steps.end_elevation_m,
+            "steps": self.steps.steps,
+            "planned_steps": self.steps.planned_steps,
+            "time_per_step_s": self.steps.time_per_step_s,
+            "terrain_collisions": self.steps.terrain_collisions,
+            "foothold_error_m": self.steps.foothold_error_m,
             "injected": self.stop.map(|stop| serde_json::json!({
                 "fault": stop.injection.fault.name(),
                 "at": stop.injection.moment.name(),
@@ -490,6 +504,16 @@ fn run_once(
         Some(stop) => format!("{} ({daemon_outcome})", stop.describe()),
         None => truth::judged_outcome(verdict.fell_at_s, &daemon_outcome),
     };
+    let planned = PlannedFootholds::new(
+        (0..sequence.len()).map(|i| sequence.contacts(i)),
+        &walk.targets,
+    );
+    let steps = StepReport::of(&walk.states, walk.submitted_ns, walk.sim_s, &planned)
+        .context("no simulator truth recorded")?;
+    // Hook for `--scene` (issue 22, item 5): a walk on a scene must also land on its footholds.
+    let on_scene = false;
+    let (success, outcome) =
+        footholds::judged_on_terrain(on_scene && stop.is_none(), (success, outcome), &steps);
     Ok(RunResult {
         robot: robot.to_owned(),
         record: WalkRecord {
@@ -516,13 +540,14 @@ fn run_once(
         trace: walk.trace,
         balance: walk.balance,
         stop,
+        steps,
     })
 }
 
 fn row(result: &RunResult) -> String {
     let r = &result.record;
     format!(
-        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{}{}",
+        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{} {}{}",
         result.robot,
         result.gait.name(),
         r.affordances.name(),
@@ -542,10 +567,32 @@ fn row(result: &RunResult) -> String {
         r.max_tilt_rad,
         result.stance_reached,
         r.stances,
+        describe_steps(&result.steps),
         r.actuators
             .as_ref()
             .map_or_else(String::new, |a| format!(" {}", a.describe()))
     )
+}
+
+/// Steps (of those planned) with their time, the foothold error, and where they are not zero the
+/// climb and the legs' terrain collisions.
+fn describe_steps(steps: &StepReport) -> String {
+    let mut out = format!("steps {}/{}", steps.steps, steps.planned_steps);
+    if let Some(t) = steps.time_per_step_s {
+        let _ = write!(out, " ({t:.2} s each)");
+    }
+    let _ = match steps.foothold_error_m {
+        Some(error) => write!(out, " foothold error {error:.3} m"),
+        None => write!(out, " foothold error n/a"),
+    };
+    let climb = steps.end_elevation_m - steps.start_elevation_m;
+    if climb.abs() >= 0.005 {
+        let _ = write!(out, " climbed {climb:+.3} m");
+    }
+    if steps.terrain_collisions > 0 {
+        let _ = write!(out, " leg-terrain collisions {}", steps.terrain_collisions);
+    }
+    out
 }
 
 /// Per robot, affordance set and distance: successes, mean simulated and wall time, real-time

@@ -22,5 +22,5 @@ pub mod mujoco;
 
 pub use adapter_loop::{AdapterError, AdapterOptions, AdapterReport, run_adapter};
 pub use robot_io::RobotIo;
-pub use simulated::{MotorLoad, SimulatedRobot};
+pub use simulated::{MotorLoad, SimulatedRobot, TerrainContacts};
 pub use truth::{GroundTruth, PublishTruth};

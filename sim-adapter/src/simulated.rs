@@ -55,10 +55,23 @@ pub trait MotorLoad {
 
 impl MotorLoad for KinematicSim {}
 
-impl<S: Simulator + MotorLoad> GroundTruth for SimulatedRobot<S> {
+/// A simulator's count of its legs' collisions with the terrain, for the `sim-truth` record:
+/// MuJoCo's leg capsules against a scene's surfaces. A simulator without terrain (the kinematic
+/// one) counts none.
+pub trait TerrainContacts {
+    /// Leg-terrain contact events since the start. No allocation.
+    fn terrain_collision_count(&self) -> u64 {
+        0
+    }
+}
+
+impl TerrainContacts for KinematicSim {}
+
+impl<S: Simulator + MotorLoad + TerrainContacts> GroundTruth for SimulatedRobot<S> {
     /// The simulated state's CoM, soles and `base_link`; fallen = the simulator's fall rule fired
     /// at any step so far ([`kinematic_sim::SafetySummary::fell`]: the CoM left the support
-    /// polygon in the kinematic simulator; base too low or tilted under MuJoCo); the motors' load.
+    /// polygon in the kinematic simulator; base too low or tilted under MuJoCo); the motors' load;
+    /// the legs' terrain collisions.
     fn ground_truth(&mut self, out: &mut SimTruth) {
         let sim = &self.sim;
         let base_link = sim.base_link_pose();
@@ -69,6 +82,7 @@ impl<S: Simulator + MotorLoad> GroundTruth for SimulatedRobot<S> {
         out.tilt_rad = tilt(&base_link);
         out.fallen = sim.summary().fell.into();
         out.actuators = sim.actuator_load();
+        out.terrain_collisions = sim.terrain_collision_count();
     }
 }
 

@@ -44,9 +44,14 @@ fn the_kinematic_robot_reports_its_simulated_state() {
     let robot = robot("jvrc1");
     let standing = robot.standing.clone();
     let mut sim = SimulatedRobot::new(KinematicSim::new(robot, standing).unwrap());
-    let mut truth = SimTruth::ZERO;
+    let mut truth = SimTruth {
+        terrain_collisions: 99,
+        ..SimTruth::ZERO
+    };
     sim.ground_truth(&mut truth);
     assert_standing("jvrc1", &truth);
+    // The kinematic simulator has no terrain: its legs never collide.
+    assert_eq!(truth.terrain_collisions, 0);
 }
 
 #[test]
@@ -110,4 +115,6 @@ fn the_mujoco_robot_reports_its_physics_state() {
     assert_eq!(truth.left_foot[..3], left.translation.vector.as_slice()[..]);
     assert_eq!(truth.base_height_m, sim.base_height());
     assert_eq!(truth.tilt_rad, sim.torso_tilt());
+    // The flat floor: the legs have no collision geometry.
+    assert_eq!(truth.terrain_collisions, 0);
 }

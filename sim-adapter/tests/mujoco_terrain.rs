@@ -1,7 +1,7 @@
 //! The MuJoCo world built from a scene (`sim_adapter::mujoco::Terrain`): every committed scene
 //! compiles into a box per surface and a capsule per railing; the robot stands at a scene's start
 //! as it does on the flat floor, with no leg touching the terrain; a shin driven into a stair's
-//! nosing is counted and named.
+//! nosing is counted and named, and the count travels in the simulator's truth.
 //! Needs the `mujoco` feature (and the library: `eval "$(scripts/setup-mujoco.sh)"`).
 #![cfg(feature = "mujoco")]
 
@@ -13,7 +13,9 @@ use kinematics::configuration::Configuration;
 use kinematics::robot::Robot;
 use mujoco_rs::prelude::MjtObjBase;
 use nalgebra::Translation3;
+use shm_types::SimTruth;
 use sim_adapter::mujoco::{MujocoOptions, MujocoSim, Terrain};
+use sim_adapter::{GroundTruth, SimulatedRobot};
 use stance::Scene;
 
 /// Control period (500 Hz, as walkd runs).
@@ -193,6 +195,9 @@ fn a_shin_driven_into_a_nosing_is_counted_and_named() {
         collisions.first.iter().all(|c| &*c.surface == "tread-1"),
         "{collisions:?}"
     );
+    // The simulator's truth (protocol v5) carries the count.
+    let count = collisions.count;
+    assert_eq!(truth_of(hit).terrain_collisions, count);
     // The same squat 1 m before the riser touches nothing.
     let clear = squat_before_the_stairs(1.0);
     assert_eq!(
@@ -203,4 +208,16 @@ fn a_shin_driven_into_a_nosing_is_counted_and_named() {
     );
     // ... and stays upright (the squat itself is stable: the pelvis only goes down).
     assert!(clear.torso_tilt() < 0.02, "tilt {} rad", clear.torso_tilt());
+    assert_eq!(truth_of(clear).terrain_collisions, 0);
+}
+
+/// What walk-sim publishes on `sim-truth` for `sim`'s current state, written over a state that
+/// claims collisions (so a count left unwritten shows).
+fn truth_of(sim: MujocoSim) -> SimTruth {
+    let mut truth = SimTruth {
+        terrain_collisions: 99,
+        ..SimTruth::ZERO
+    };
+    SimulatedRobot::new(sim).ground_truth(&mut truth);
+    truth
 }

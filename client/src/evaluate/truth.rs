@@ -11,6 +11,8 @@ use std::time::Duration;
 use anyhow::Context;
 use shm_types::{ServiceNames, SimTruth, TruthSubscriber};
 
+use super::footholds;
+
 /// How often the recorder drains the subscriber.
 const DRAIN_PERIOD: Duration = Duration::from_micros(500);
 
@@ -88,16 +90,12 @@ pub(crate) struct Verdict {
     pub(crate) fell_at_s: Option<f64>,
     /// Largest `base_link` tilt from the vertical since submission (rad).
     pub(crate) max_tilt_rad: f64,
-    /// Simulated time from submission at which a sole first rose [`STEP_HEIGHT_M`] above its
-    /// height at submission: the first step (s).
+    /// Simulated time from submission at which a sole first rose [`footholds::STEP_HEIGHT_M`] above its
+    /// height at submission: the first step's lift-off ([`footholds::swings`]) (s).
     pub(crate) first_step_s: Option<f64>,
     /// Horizontal distance the midpoint of the soles travelled from submission to the end (m).
     pub(crate) walked_m: f64,
 }
-
-/// How far a sole must rise for the walk to have stepped (m): above the contact compliance,
-/// below the lowest swing (`h_min`).
-pub(crate) const STEP_HEIGHT_M: f64 = 0.01;
 
 /// The horizontal midpoint of the two simulated soles.
 fn feet_midpoint(state: &SimTruth) -> [f64; 2] {
@@ -111,15 +109,13 @@ impl Verdict {
     /// The verdict of the recorded `states`; `None` when nothing was recorded.
     pub(crate) fn of(states: &[SimTruth], submitted_ns: u64) -> Option<Self> {
         let end = *states.last()?;
-        let since_submission = || states.iter().filter(|s| s.timestamp_ns >= submitted_ns);
-        let at_submission = state_at(states, submitted_ns).unwrap_or(&states[0]);
+        // From the newest state before the submission: where the walk starts.
+        let walk = footholds::since_submission(states, submitted_ns);
+        let at_submission = &walk[0];
         let submitted_at = at_submission.sim_time_s;
-        let (left_z, right_z) = (at_submission.left_foot[2], at_submission.right_foot[2]);
-        let first_step_s = since_submission()
-            .find(|s| {
-                s.left_foot[2] > left_z + STEP_HEIGHT_M || s.right_foot[2] > right_z + STEP_HEIGHT_M
-            })
-            .map(|s| s.sim_time_s - submitted_at);
+        let first_step_s = footholds::swings(walk)
+            .first()
+            .map(|swing| swing.lift_s - submitted_at);
         let (start, finish) = (feet_midpoint(at_submission), feet_midpoint(&end));
         let walked_m = (finish[0] - start[0]).hypot(finish[1] - start[1]);
         // The flag is sticky: the end state says whether a fall happened at all, even if the
@@ -131,7 +127,11 @@ impl Verdict {
         Some(Self {
             end,
             fell_at_s,
-            max_tilt_rad: since_submission().map(|s| s.tilt_rad).fold(0.0, f64::max),
+            max_tilt_rad: states
+                .iter()
+                .filter(|s| s.timestamp_ns >= submitted_ns)
+                .map(|s| s.tilt_rad)
+                .fold(0.0, f64::max),
             first_step_s,
             walked_m,
         })

@@ -18,7 +18,8 @@
 //! With `--snapshots` (MuJoCo only, feature `render`) it saves a side view of the robot every
 //! `--snapshot-period` of simulated time (`sim_adapter::mujoco::render`).
 //! Besides the adapter side of the contract it publishes the simulator's ground truth (CoM,
-//! sole poses, base height and tilt, fall flag) on `<prefix>/sim-truth` with every sample.
+//! sole poses, base height and tilt, fall flag, motor load, leg-terrain collision count) on
+//! `<prefix>/sim-truth` with every sample.
 //!
 //! Exit codes: see `shm_types::process::exit_code` (0 clean, 3 config/model, 4 IPC, 1 other).
 
@@ -40,7 +41,9 @@ use shm_types::{
     current_thread_is_fifo,
 };
 use sim_adapter::inject::{FaultInjector, FaultPlan};
-use sim_adapter::{AdapterOptions, MotorLoad, PublishTruth, SimulatedRobot, run_adapter};
+use sim_adapter::{
+    AdapterOptions, MotorLoad, PublishTruth, SimulatedRobot, TerrainContacts, run_adapter,
+};
 
 /// Simulated robot for walkd: publishes sensor samples, applies joint commands.
 #[derive(Parser)]
@@ -280,7 +283,7 @@ fn serve_mujoco(
 
 /// Runs the adapter loop for `sim` until terminated, publishing its ground truth with every
 /// sample (and injecting the fault of `--inject`); logs the simulator's safety summary.
-fn serve<S: Simulator + MotorLoad>(
+fn serve<S: Simulator + MotorLoad + TerrainContacts>(
     runtime: &RuntimeConfig,
     args: &Args,
     sim: SimulatedRobot<S>,
@@ -315,11 +318,12 @@ fn serve<S: Simulator + MotorLoad>(
         spin_us = spin.as_micros() as u64,
         "walk-sim running"
     );
-    let (report, safety) = match fault {
+    let (report, safety, terrain_collisions) = match fault {
         None => {
             let mut sim = sim;
             let report = run_adapter(&ports, &mut sim, &options, &termination_requested);
-            (report, *sim.robot().sim().summary())
+            let sim = sim.robot().sim();
+            (report, *sim.summary(), sim.terrain_collision_count())
         }
         Some(plan) => {
             tracing::info!(
@@ -330,7 +334,8 @@ fn serve<S: Simulator + MotorLoad>(
             );
             let mut sim = FaultInjector::new(sim, plan, limit_fault, &names);
             let report = run_adapter(&ports, &mut sim, &options, &termination_requested);
-            (report, *sim.robot().robot().sim().summary())
+            let sim = sim.robot().robot().sim();
+            (report, *sim.summary(), sim.terrain_collision_count())
         }
     };
     let report = report.map_err(|e| (exit_code::IPC, e.into()))?;
@@ -341,6 +346,7 @@ fn serve<S: Simulator + MotorLoad>(
         overruns = report.overruns,
         fell = safety.fell,
         min_stability_margin_m = safety.min_stability_margin,
+        terrain_collisions,
         "walk-sim stopped"
     );
     Ok(())

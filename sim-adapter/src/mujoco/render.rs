@@ -168,6 +168,12 @@ impl crate::MotorLoad for PhotographedSim {
     }
 }
 
+impl crate::TerrainContacts for PhotographedSim {
+    fn terrain_collision_count(&self) -> u64 {
+        crate::TerrainContacts::terrain_collision_count(&self.sim)
+    }
+}
+
 impl Simulator for PhotographedSim {
     type Error = MujocoError;
 

@@ -353,6 +353,13 @@ impl crate::MotorLoad for MujocoSim {
     }
 }
 
+impl crate::TerrainContacts for MujocoSim {
+    /// [`MujocoSim::terrain_collisions`]' count (0 on the flat floor).
+    fn terrain_collision_count(&self) -> u64 {
+        self.terrain_collisions().count
+    }
+}
+
 impl Layout {
     fn resolve(model: &MjModel, robot: &Robot, bodies: &RigidBodies) -> Result<Self, MujocoError> {
         let id = |kind: MjtObjBase, name: &str| {
