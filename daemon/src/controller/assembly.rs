@@ -143,7 +143,7 @@ impl QpAssembler {
                 self.polygon_from_contacts(robot, targets);
                 self.polygon.edge_count()
             }
-            Balance::ComHeight(_) => 0,
+            Balance::ComHeight { .. } => 0,
         };
         self.problem
             .set_active_rows(6 * feet_in_contact, m_ineq)
@@ -159,14 +159,14 @@ impl QpAssembler {
         // CoM x/y, and its height when the gait holds it.
         kinematics.com_jacobian(model, &mut self.com_jacobian);
         let com = kinematics.com();
-        let (com_rows, height) = match targets.balance {
-            Balance::SupportPolygon => (2, com.z),
-            Balance::ComHeight(height) => (3, height),
+        let (com_rows, height, height_velocity) = match targets.balance {
+            Balance::SupportPolygon => (2, com.z, 0.0),
+            Balance::ComHeight { height, velocity } => (3, height, velocity),
         };
         let com_velocity = [
             targets.com_velocity.x + config.com_gain * (targets.com.x - com.x),
             targets.com_velocity.y + config.com_gain * (targets.com.y - com.y),
-            config.com_gain * (height - com.z),
+            height_velocity + config.com_gain * (height - com.z),
         ];
         add_task(
             &mut p,

@@ -79,8 +79,9 @@ pub(crate) enum Balance {
     /// height is free.
     SupportPolygon,
     /// The CoM set-point moves like a pendulum whose ZMP stays in the support (the dynamic
-    /// gait), so no polygon constraint; the CoM is held at this height (world z, m).
-    ComHeight(f64),
+    /// gait), so no polygon constraint; the CoM follows this height (world z, m) with this
+    /// feed-forward vertical velocity (m/s).
+    ComHeight { height: f64, velocity: f64 },
 }
 
 /// Result of one state-machine update.
@@ -299,6 +300,18 @@ impl StateMachine {
         self.to_world * self.sequence().stances[self.stance].targets[e as usize]
     }
 
+    /// Height of the contact `foot` swings to: its target in the first stance from the current
+    /// one where it is in contact (the current target if none is).
+    fn landing_height(&self, foot: EndEffector) -> f64 {
+        let stances = &self.sequence().stances[self.stance..];
+        stances
+            .iter()
+            .find(|stance| stance.contacts[foot as usize])
+            .map_or(self.world_target(foot).translation.z, |stance| {
+                stance.targets[foot as usize].translation.z
+            })
+    }
+
     fn begin_transition(&mut self, feedback: &Feedback) {
         let next = self.sequence().stances[self.stance].contacts;
         let is_last = self.stance + 1 == self.sequence().len();
@@ -361,9 +374,13 @@ impl StateMachine {
                     PoseTrajectory::new(start, goal, c.min_motion_s, Profile::MinimumJerk);
                 c.min_motion_s
             }
-            (Phase::Lift, Some(_)) => {
+            (Phase::Lift, Some(foot)) => {
+                // Up a step, straight up above the landing's surface first, so the toe clears
+                // the riser ahead before the foot moves forward.
                 let start = *self.motion.goal();
-                let goal = raised(&start, c.lift_height_m);
+                let climb =
+                    self.landing_height(foot) - self.targets.anchors[foot as usize].translation.z;
+                let goal = raised(&start, c.lift_height_m + climb_above_step(climb));
                 self.timed_motion(start, goal, Profile::MinimumJerk);
                 self.motion.duration()
             }
@@ -375,7 +392,11 @@ impl StateMachine {
                 let goal = if self.motion_is_via {
                     target
                 } else {
-                    raised(&target, c.approach_height_m)
+                    // Down a step, the approach stays above the surface the foot left, so the
+                    // heel clears the nosing behind the landing: the lowering goes straight down.
+                    let descent =
+                        self.targets.anchors[foot as usize].translation.z - target.translation.z;
+                    raised(&target, c.approach_height_m + climb_above_step(descent))
                 };
                 self.timed_motion(start, goal, Profile::MinimumJerk);
                 self.motion.duration()
@@ -596,6 +617,16 @@ pub(crate) fn heading_frame(pose: &Isometry3<f64>) -> Isometry3<f64> {
 }
 
 /// `pose` moved up by `height` along world z.
+/// A height difference between where a foot lifts off and where it lands counts as a step up
+/// or down (a stair or a ramp) above this (m); below it the swing is the flat-ground one.
+const STEP_HEIGHT_M: f64 = 0.01;
+
+/// The extra height of a swing that climbs (or descends) `height` (m): all of it for a step,
+/// none on flat ground.
+fn climb_above_step(height: f64) -> f64 {
+    if height > STEP_HEIGHT_M { height } else { 0.0 }
+}
+
 fn raised(pose: &Isometry3<f64>, height: f64) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::from(pose.translation.vector + Vector3::z() * height),

@@ -14,6 +14,7 @@
 mod compliance;
 mod config;
 mod dcm;
+mod elevation;
 mod footsteps;
 mod sensing;
 mod stabilizer;

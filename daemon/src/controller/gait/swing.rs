@@ -6,15 +6,29 @@
 //! Minimum-jerk pieces start and end with zero velocity and acceleration, so the foot leaves the
 //! ground and lands at rest, and the halves join smoothly at the apex (vertical velocity and
 //! acceleration zero there).
+//!
+//! A step up or down (landing and lift-off more than [`STEP_HEIGHT_M`] apart, a stair or a ramp)
+//! moves horizontally over part of the swing only, so the sole is high before it passes an edge:
+//! climbing, the foot first rises for [`EDGE_CLEARING_SHARE`] of the swing, so its toe clears
+//! the riser in front of it; descending, it arrives above its landing that share before the
+//! end, so its heel clears the nosing behind the landing while it comes down.
 
 use nalgebra::{Isometry3, Translation3, Vector2};
 
 use crate::controller::trajectory::{PointTrajectory, PoseTrajectory, Profile};
 
+/// A height difference between lift-off and landing above which a swing is a step up or down.
+pub(crate) const STEP_HEIGHT_M: f64 = 0.01;
+
+/// The share of a step up's (down's) swing before (after) its horizontal motion.
+pub(crate) const EDGE_CLEARING_SHARE: f64 = 0.25;
+
 /// A swing from lift-off to landing.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SwingTrajectory {
     horizontal: PointTrajectory,
+    /// When the horizontal motion starts, after lift-off (s).
+    horizontal_start: f64,
     rise: PoseTrajectory,
     descent: PoseTrajectory,
     duration: f64,
@@ -37,8 +51,18 @@ impl SwingTrajectory {
             apex.rotation,
         );
         let half = duration / 2.0;
+        let climb = landing.translation.z - lift_off.translation.z;
+        let edge_clearing = EDGE_CLEARING_SHARE * duration;
+        let (horizontal_start, horizontal_duration) = if climb > STEP_HEIGHT_M {
+            (edge_clearing, duration - edge_clearing)
+        } else if climb < -STEP_HEIGHT_M {
+            (0.0, duration - edge_clearing)
+        } else {
+            (0.0, duration)
+        };
         Self {
-            horizontal: PointTrajectory::new(start, goal, duration),
+            horizontal: PointTrajectory::new(start, goal, horizontal_duration),
+            horizontal_start,
             rise: PoseTrajectory::new(lift_off, top, half, Profile::MinimumJerk),
             descent: PoseTrajectory::new(top, landing, half, Profile::MinimumJerk),
             duration,
@@ -54,7 +78,8 @@ impl SwingTrajectory {
     /// swing, the landing pose at rest.
     pub fn sample(&self, t: f64) -> (Isometry3<f64>, [f64; 6]) {
         let half = self.duration / 2.0;
-        let (xy, xy_velocity): (Vector2<f64>, Vector2<f64>) = self.horizontal.sample(t);
+        let (xy, xy_velocity): (Vector2<f64>, Vector2<f64>) =
+            self.horizontal.sample(t - self.horizontal_start);
         let (mut pose, mut velocity) = if t < half {
             self.rise.sample(t)
         } else {
@@ -133,6 +158,49 @@ mod tests {
         let (swing, ..) = swing();
         for t in [0.1, 0.25, 0.31, 0.45] {
             assert_velocity_is_derivative(|t| swing.sample(t), t);
+        }
+    }
+
+    /// Whether a sole of half-length `half` swinging one stair up (`up`) or down, over treads
+    /// 0.3 m deep with 0.1 m risers, stays above every tread it is over.
+    fn clears_the_stairs(up: bool) -> bool {
+        let half = 0.112;
+        let (rise, apex) = if up { (0.2, 0.23) } else { (-0.2, 0.03) };
+        let at = |x: f64, z: f64| Isometry3::translation(x, 0.1, z);
+        let swing = SwingTrajectory::new(at(0.0, 0.0), at(0.3, apex), at(0.6, rise), 1.0);
+        // Tread k (the lift-off's) spans x < 0.15, k ± 1 up to 0.45, k ± 2 beyond.
+        let tread = |x: f64| rise * (((x + 0.15) / 0.3).floor() / 2.0).clamp(0.0, 1.0);
+        (0..=1000).all(|k| {
+            let (pose, _) = swing.sample(f64::from(k) * 1e-3);
+            let (x, z) = (pose.translation.x, pose.translation.z);
+            let highest = tread(x - half).max(tread(x + half));
+            z >= highest - 1e-9
+        })
+    }
+
+    #[test]
+    fn a_step_up_or_down_clears_the_stair_edges_and_a_plain_swing_would_not() {
+        assert!(clears_the_stairs(true), "up");
+        assert!(clears_the_stairs(false), "down");
+        // The same step up with the horizontal motion over the whole swing hits the riser.
+        let at = |x: f64, z: f64| Isometry3::translation(x, 0.1, z);
+        let plain = SwingTrajectory::new(at(0.0, 0.0), at(0.3, 0.23), at(0.6, 0.0), 1.0);
+        let (early, _) = plain.sample(0.2);
+        let shaped = SwingTrajectory::new(at(0.0, 0.0), at(0.3, 0.23), at(0.6, 0.2), 1.0);
+        let (delayed, _) = shaped.sample(0.2);
+        assert!(delayed.translation.x < early.translation.x - 0.03);
+    }
+
+    #[test]
+    fn a_shaped_swing_has_consistent_velocities() {
+        let at = |x: f64, z: f64| Isometry3::translation(x, 0.1, z);
+        for landing in [0.2, -0.2] {
+            let swing = SwingTrajectory::new(at(0.0, 0.0), at(0.3, 0.23), at(0.6, landing), 1.0);
+            for t in [0.1, 0.3, 0.55, 0.8] {
+                assert_velocity_is_derivative(|t| swing.sample(t), t);
+            }
+            let (end, _) = swing.sample(1.0);
+            assert!((end.translation.x - 0.6).abs() < 1e-12);
         }
     }
 }

@@ -40,6 +40,7 @@ use nalgebra::{DVector, Isometry3, UnitQuaternion, Vector2, Vector3};
 
 use super::DynamicPlan;
 use super::compliance::{TiltDamping, distribute, foot_damping, force_difference};
+use super::elevation::support_elevation;
 use super::footsteps::{FEET, Support, SupportPhase, SwingPlan};
 use super::sensing::{DcmEstimator, TiltRate, pressure_centre, tilted_com};
 use super::stabilizer::{Measured, Stabilizer};
@@ -624,7 +625,12 @@ impl DynamicWalker {
             .update(&reference, &measured, &self.support, dt);
         self.targets.com = command.com;
         self.targets.com_velocity = command.com_velocity;
-        self.targets.balance = Balance::ComHeight(ground + self.plan().com_height);
+        let (elevation, rate) =
+            support_elevation(&self.plan().footsteps.phases, self.phase, self.clock);
+        self.targets.balance = Balance::ComHeight {
+            height: elevation + self.plan().com_height,
+            velocity: rate,
+        };
         self.targets.torso_posture_weight = self.plan().config.torso_posture_weight;
         if self.blind {
             // No force-torque to comply with: the feet hold their anchors, and the compliance
