@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use anyhow::Context;
 use clap::builder::RangedU64ValueParser;
@@ -16,7 +16,7 @@ use client::evaluate::{GroupSummary, MatrixCells, WalkRecord, group_by_cell, spe
 use kinematics::ConfigFile;
 use kinematics::bounds::Range;
 use serde::Serialize;
-use stance::{Gait, WalkRequest};
+use stance::{Gait, Scene, WalkRequest};
 
 use crate::physics::{PhysicsWalkOptions, PhysicsWalkReport, Push, walk_distance};
 
@@ -76,6 +76,10 @@ pub struct MatrixArgs {
     /// How long the push acts (s, 0.001-5).
     #[arg(long, default_value_t = 0.1, value_parser = Range::new(0.001, 5.0).parser())]
     pub push_duration: f64,
+    /// Walk every run through this scene (docs/scenes.md), from its start to its goal, instead
+    /// of on the flat floor; the path's length replaces `--distances`.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
     /// Walks run at once (each in its own thread), 1-64.
     #[arg(long, default_value_t = 1, value_parser = RangedU64ValueParser::<usize>::new().range(1..=64))]
     pub jobs: usize,
@@ -221,7 +225,14 @@ pub fn walk_matrix(
         .and_then(toml::Value::as_str)
         .unwrap_or("robot")
         .to_owned();
-    let requests = args.cells.requests()?;
+    let requests = match &options.scene {
+        Some(scene) => MatrixCells {
+            distances: vec![scene.path_length()],
+            ..args.cells.clone()
+        }
+        .requests()?,
+        None => args.cells.requests()?,
+    };
     let runs = run_all(config, args, &options, &requests);
     let groups = groups(&runs);
     Ok(MatrixReport {
@@ -256,6 +267,9 @@ pub fn walk_options(args: &MatrixArgs, gait: Gait) -> anyhow::Result<PhysicsWalk
         .mujoco
         .check()
         .context("--mass-scale / --pelvis-com-offset")?;
+    if let Some(path) = &args.scene {
+        options.scene = Some(Arc::new(Scene::from_path(path)?));
+    }
     if let Some(impulse) = args.push_impulse {
         options.push = Some(Push {
             step: args.push_step,

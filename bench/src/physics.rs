@@ -30,14 +30,16 @@ use kinematics::ground::GRAVITY;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Vector2, Vector3};
 use sim_adapter::MotorLoad;
-use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim};
+use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim, Terrain};
 use stance::poses::FEET;
-use stance::{PostProcessParams, PostProcessedSequence, WalkRequest, synthetic_walk};
+use stance::{
+    PostProcessParams, PostProcessedSequence, Scene, WalkRequest, generate, synthetic_walk, walk_on,
+};
 
 use crate::closed_loop::{ClosedLoop, TickError, feet_midpoint};
 
 /// How to run a physics walk.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct PhysicsWalkOptions {
     /// QP back-end of the controller.
     pub solver: SolverKind,
@@ -58,6 +60,9 @@ pub struct PhysicsWalkOptions {
     pub dynamic: Option<DynamicGaitConfig>,
     /// A push on the pelvis during the walk.
     pub push: Option<Push>,
+    /// The scene the walk goes through from its start to its goal (docs/scenes.md); `None`:
+    /// the flat floor.
+    pub scene: Option<Arc<Scene>>,
 }
 
 impl Default for PhysicsWalkOptions {
@@ -72,6 +77,7 @@ impl Default for PhysicsWalkOptions {
             gait: Gait::Static,
             dynamic: None,
             push: None,
+            scene: None,
         }
     }
 }
@@ -245,7 +251,8 @@ impl PhysicsWalkReport {
 }
 
 /// Generates the walk of `request` for the robot of `config`, post-processes it with the
-/// parameters of `options.gait` and walks it under physics.
+/// parameters of `options.gait` (onto `options.scene`'s surfaces, if any) and walks it under
+/// physics.
 pub fn walk_distance(
     config: &ConfigFile,
     urdf: Option<&Path>,
@@ -261,7 +268,16 @@ pub fn walk_distance(
     if options.dynamic.is_some() {
         gaits.dynamic = options.dynamic;
     }
-    let sequence = synthetic_walk(&robot, &params, request)?;
+    let sequence = match &options.scene {
+        Some(scene) => walk_on(
+            &robot,
+            &params,
+            request,
+            &scene.walk_environment().surfaces,
+            |options| generate(&robot, options),
+        )?,
+        None => synthetic_walk(&robot, &params, request)?,
+    };
     walk_sequence(robot, controller_config, &gaits, &sequence, options)
 }
 
@@ -287,8 +303,21 @@ pub fn walk_sequence(
     });
     let mut targets = stance_points(&robot, sequence);
     let controller = Controller::new(robot.clone(), config, options.solver)?;
-    let sim = MujocoSim::new(robot.clone(), &robot.urdf, &robot.standing, options.mujoco)
-        .context("building the MuJoCo model")?;
+    let sim = match &options.scene {
+        Some(scene) => {
+            let terrain = Terrain::from_scene(scene).context("building the scene's terrain")?;
+            let initial = terrain.place(&robot.standing);
+            MujocoSim::on_terrain(
+                robot.clone(),
+                &robot.urdf,
+                &initial,
+                options.mujoco,
+                terrain,
+            )
+        }
+        None => MujocoSim::new(robot.clone(), &robot.urdf, &robot.standing, options.mujoco),
+    }
+    .context("building the MuJoCo model")?;
     let mut closed = ClosedLoop::new(controller, sim, options.rate_hz);
     if closed.controller.start(Box::new(prepared)).is_err() {
         anyhow::bail!("a new controller refused to start");

@@ -14,7 +14,7 @@ use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::process::Physics;
 use shm_types::{ClockMode, DaemonState, DaemonStatus, LatencySummary, RuntimeConfig};
-use stance::{Gait, WalkRequest};
+use stance::{Gait, Scene, WalkRequest};
 
 use crate::args::{DISTANCE_M, RATE_HZ};
 use crate::daemon_client::connect_when_fresh;
@@ -90,6 +90,10 @@ pub struct DemoArgs {
     /// `DIR/fig6-<robot>.svg`.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
+    /// Walk through this scene (docs/scenes.md) from its start to its goal instead of
+    /// `--distance` on the flat floor; needs `--physics mujoco`.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
 }
 
 /// What the demo measured: the watched walk, its gait and the plot.
@@ -224,6 +228,38 @@ pub fn walk_sequence(
     )?)
 }
 
+/// [`walk_sequence`] through `scene`, from its start to its goal: the synthetic walk of the
+/// path's length, post-processed onto the scene's surfaces.
+pub fn scene_walk_sequence(
+    robot: &Robot,
+    file: &ConfigFile,
+    scene: &Scene,
+    seed: u64,
+    gait: Gait,
+) -> anyhow::Result<stance::PostProcessedSequence> {
+    let params = stance::PostProcessParams::from_config_for(file, gait)?;
+    let request = WalkRequest::feet(scene.path_length(), seed);
+    let surfaces = scene.walk_environment().surfaces;
+    Ok(stance::walk_on(
+        robot,
+        &params,
+        &request,
+        &surfaces,
+        |options| stance::generate(robot, options),
+    )?)
+}
+
+/// The scene of `--scene`, refused before anything starts when the simulator cannot model it.
+pub fn load_scene(path: Option<&Path>, physics: Physics) -> anyhow::Result<Option<Scene>> {
+    let Some(path) = path else {
+        return Ok(None);
+    };
+    if physics != Physics::Mujoco {
+        bail!("--scene needs --physics mujoco: the kinematic simulator does not model terrain yet");
+    }
+    Ok(Some(Scene::from_path(path)?))
+}
+
 /// Runs the demo and returns what it measured (also used by the e2e tests).
 pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     let config = match &args.config {
@@ -239,7 +275,11 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         .clone()
         .unwrap_or(runtime.service_prefix);
     let robot = std::sync::Arc::new(Robot::from_config(&file, args.urdf.as_deref())?);
-    let sequence = walk_sequence(&robot, &file, args.distance, args.seed, gait)?;
+    let scene = load_scene(args.scene.as_deref(), args.physics)?;
+    let sequence = match &scene {
+        Some(scene) => scene_walk_sequence(&robot, &file, scene, args.seed, gait)?,
+        None => walk_sequence(&robot, &file, args.distance, args.seed, gait)?,
+    };
     let mut children = Processes::default();
     let running = DaemonClient::connect(&prefix).is_ok_and(|client| client.is_running());
     if !running {
@@ -251,7 +291,10 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
             rate_hz: args.rate_hz,
             urdf: args.urdf.clone(),
         };
-        let plant = PlantArgs::new(args.physics, gait, &file);
+        let mut plant = PlantArgs::new(args.physics, gait, &file);
+        if let Some(path) = &args.scene {
+            plant.walk_sim.extend(["--scene".into(), path.into()]);
+        }
         children.0.push(launch.walkd(&plant.walkd, &[])?);
         children
             .0

@@ -51,7 +51,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use shm_types::process::Physics;
 use shm_types::{ClockMode, DaemonState, SimTruth};
 use stance::poses::FEET;
-use stance::{AffordanceSet, Gait, PostProcessedSequence, WalkRequest};
+use stance::{AffordanceSet, Gait, PostProcessedSequence, Scene, WalkRequest};
 
 use crate::daemon_client::connect_when_fresh;
 use crate::process::{Launch, PlantArgs, executable_dir};
@@ -100,6 +100,10 @@ pub struct EvaluateArgs {
     /// Faults to inject into every walk, and when.
     #[command(flatten)]
     pub inject: InjectArgs,
+    /// Walk every run through this scene (docs/scenes.md), from its start to its goal, instead
+    /// of on the flat floor; the path's length replaces `--distances`. Needs `--physics mujoco`.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
 }
 
 /// The CoM and both soles' positions in the world (m).
@@ -321,7 +325,15 @@ impl<'a> Subject<'a> {
 /// `walkctl evaluate`: runs the matrix, prints the table or JSON, writes the plots; fails unless
 /// every run succeeded.
 pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
-    let requests = args.cells.requests()?;
+    let scene = crate::demo::load_scene(args.scene.as_deref(), args.physics)?;
+    let requests = match &scene {
+        Some(scene) => MatrixCells {
+            distances: vec![scene.path_length()],
+            ..args.cells.clone()
+        }
+        .requests()?,
+        None => args.cells.requests()?,
+    };
     let subjects = args
         .robots
         .iter()
@@ -338,8 +350,9 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         });
         for (i, (request, injection)) in runs.enumerate() {
             let pictured = args.snapshots.as_deref().filter(|_| i == 0);
-            let result =
-                run_once(args, subject, (i, request), *injection, pictured).with_context(|| {
+            let run = (i, request);
+            let result = run_once(args, subject, run, scene.as_ref(), *injection, pictured)
+                .with_context(|| {
                     format!(
                         "{robot} {} {} m run {}{}",
                         request.affordances,
@@ -391,13 +404,14 @@ fn plot_robot(dir: &Path, robot: &str, results: &[RunResult]) -> anyhow::Result<
     write_fig6(&file, &title, &result.trace, &result.balance)
 }
 
-/// Run number `slot` of a robot: own processes on an own prefix, submit, record, stop; with
-/// `injection`, walk-sim injects that fault; with `pictured`, the snapshots of `--snapshots` go
-/// there.
+/// Run number `slot` of a robot: own processes on an own prefix, submit, record, stop; through
+/// `scene` if any; with `injection`, walk-sim injects that fault; with `pictured`, the
+/// snapshots of `--snapshots` go there.
 fn run_once(
     args: &EvaluateArgs,
     subject: &Subject,
     (slot, request): (usize, &WalkRequest),
+    scene: Option<&Scene>,
     injection: Option<Injection>,
     pictured: Option<&Path>,
 ) -> anyhow::Result<RunResult> {
@@ -416,7 +430,15 @@ fn run_once(
         affordances,
         seed: run,
     } = request;
-    let sequence = stance::synthetic_walk(model, &params, request)?;
+    let sequence = match scene {
+        Some(scene) => {
+            let surfaces = scene.walk_environment().surfaces;
+            stance::walk_on(model, &params, request, &surfaces, |options| {
+                stance::generate(model, options)
+            })?
+        }
+        None => stance::synthetic_walk(model, &params, request)?,
+    };
     // One prefix a run: the runs of one walk with different faults follow each other, and a new
     // walkd must not meet the services of the last one while they are being torn down.
     let prefix = format!("walk-eval/{robot}/{}/{slot}", std::process::id());
@@ -431,10 +453,17 @@ fn run_once(
     let frames = pictured.map(|dir| dir.join(format!("frames-{robot}")));
     let plant = PlantArgs::new(args.physics, gait, file);
     let mut sim_args = plant.walk_sim;
+    if let Some(scene) = &args.scene {
+        sim_args.extend(["--scene".into(), scene.into()]);
+    }
     if let Some(frames) = &frames {
         let _ = std::fs::remove_dir_all(frames);
-        // The side camera looks at the middle of the walk (it starts at x = 0 along +x).
-        let lookat = format!("{},0,0.8", distance / 2.0);
+        // The side camera looks at the middle of the walk: on the flat floor it starts at x = 0
+        // along +x; through a scene, between its start and its goal.
+        let middle = scene.map_or(Vector3::new(distance / 2.0, 0.0, 0.0), |scene| {
+            (scene.start.translation.vector + scene.goal) / 2.0
+        });
+        let lookat = format!("{},{},{}", middle.x, middle.y, middle.z + 0.8);
         sim_args.extend(["--snapshots".into(), frames.into()]);
         sim_args.extend(["--snapshot-lookat".into(), lookat.into()]);
     }
@@ -510,10 +539,12 @@ fn run_once(
     );
     let steps = StepReport::of(&walk.states, walk.submitted_ns, walk.sim_s, &planned)
         .context("no simulator truth recorded")?;
-    // Hook for `--scene` (issue 22, item 5): a walk on a scene must also land on its footholds.
-    let on_scene = false;
-    let (success, outcome) =
-        footholds::judged_on_terrain(on_scene && stop.is_none(), (success, outcome), &steps);
+    // Through a scene a walk must also land on its footholds (its treads).
+    let (success, outcome) = footholds::judged_on_terrain(
+        scene.is_some() && stop.is_none(),
+        (success, outcome),
+        &steps,
+    );
     Ok(RunResult {
         robot: robot.to_owned(),
         record: WalkRecord {

@@ -7,7 +7,7 @@ use anyhow::Context;
 use kinematics::ConfigFile;
 use kinematics::bounds::Range;
 use stance::learned::SourceArgs;
-use stance::{AffordanceSet, Gait, GenerateOptions};
+use stance::{AffordanceSet, Gait, GenerateOptions, Scene};
 
 use crate::args::DISTANCE_M;
 use crate::postprocess::{ParamOverrides, load_robot};
@@ -23,8 +23,13 @@ pub struct GenerateArgs {
     pub urdf: Option<PathBuf>,
     /// Distance the post-processed walk should cover [m]; the raw sequence is generated for
     /// D / scf (the paper's rule), with scf from `[postprocess]` or `--scf`.
-    #[arg(long, value_name = "D", value_parser = DISTANCE_M.parser())]
-    pub distance: f64,
+    #[arg(long, value_name = "D", value_parser = DISTANCE_M.parser(), required_unless_present = "scene", conflicts_with = "scene")]
+    pub distance: Option<f64>,
+    /// Walk through this scene (docs/scenes.md) from its start to its goal: the distance is the
+    /// path's length, and the raw sequence carries the scene's surfaces (in the walk's frame,
+    /// starting at the origin) for `walkctl postprocess` to put the walk onto.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
     /// Generate exactly D metres (no division by scf).
     #[arg(long)]
     pub raw_distance: bool,
@@ -66,10 +71,17 @@ pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
     } else {
         1.0 / args.params.load(&args.robot)?.scf
     };
-    let distance = args.distance * scale;
+    let scene = args.scene.as_deref().map(Scene::from_path).transpose()?;
+    let walk_distance = match &scene {
+        Some(scene) => scene.path_length(),
+        None => args
+            .distance
+            .expect("clap requires --distance without --scene"),
+    };
+    let distance = walk_distance * scale;
     let railing = args
         .railing
-        .unwrap_or([0.0, args.distance])
+        .unwrap_or([0.0, walk_distance])
         .map(|s| s * scale);
     let options = GenerateOptions {
         distance,
@@ -86,7 +98,10 @@ pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
             sourced.raw.len()
         );
     }
-    let raw = sourced.raw;
+    let raw = match &scene {
+        Some(scene) => sourced.raw.on_surfaces(&scene.walk_environment().surfaces),
+        None => sourced.raw,
+    };
     std::fs::write(&args.output, raw.to_json_string())
         .with_context(|| format!("writing {}", args.output.display()))?;
     eprintln!(

@@ -48,4 +48,4 @@ pub use pipeline::PostProcessor;
 pub use poses::PoseSequence;
 pub use scene::{Scene, SceneError};
 pub use sequence::{PostProcessedSequence, RawSequence, Stance, StanceSequence};
-pub use walk::{WalkRequest, synthetic_walk};
+pub use walk::{WalkRequest, synthetic_walk, walk_on};

@@ -5,7 +5,7 @@
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-use crate::environment::Environment;
+use crate::environment::{Environment, SupportSurface};
 use crate::error::{FormatError, Location};
 use crate::params::Gait;
 
@@ -155,6 +155,13 @@ impl RawSequence {
         Ok(Self {
             sequence: StanceSequence::new(robot, joint_names, environment, stances)?,
         })
+    }
+
+    /// The same walk on other support surfaces (a scene's, in the walk's frame): a stance source
+    /// generates on flat ground, and post-processing puts the walk onto these.
+    pub fn on_surfaces(mut self, surfaces: &[SupportSurface]) -> Self {
+        self.sequence.environment.surfaces = surfaces.to_vec();
+        self
     }
 }
 

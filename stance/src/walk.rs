@@ -5,6 +5,7 @@
 
 use kinematics::robot::Robot;
 
+use crate::environment::SupportSurface;
 use crate::error::FormatError;
 use crate::generate::{AffordanceSet, GenerateError, GenerateOptions, generate};
 use crate::params::PostProcessParams;
@@ -53,7 +54,7 @@ pub enum WalkError<E: std::error::Error> {
     PostProcess(FormatError),
 }
 
-/// The walk of `request`: `source` generates the raw sequence for the options of
+/// The walk of `request` on flat ground: `source` generates the raw sequence for the options of
 /// [`WalkRequest::generate_options`], then it is post-processed with `params`.
 pub fn walk_with<E: std::error::Error>(
     robot: &Robot,
@@ -61,9 +62,21 @@ pub fn walk_with<E: std::error::Error>(
     request: &WalkRequest,
     source: impl FnOnce(&GenerateOptions) -> Result<RawSequence, E>,
 ) -> Result<PostProcessedSequence, WalkError<E>> {
+    walk_on(robot, params, request, &[SupportSurface::ground()], source)
+}
+
+/// [`walk_with`] on `surfaces` (a scene's, in the walk's frame: [`crate::Scene::walk_environment`]):
+/// the source's flat walk is post-processed onto them.
+pub fn walk_on<E: std::error::Error>(
+    robot: &Robot,
+    params: &PostProcessParams,
+    request: &WalkRequest,
+    surfaces: &[SupportSurface],
+    source: impl FnOnce(&GenerateOptions) -> Result<RawSequence, E>,
+) -> Result<PostProcessedSequence, WalkError<E>> {
     let raw = source(&request.generate_options(params)).map_err(WalkError::Source)?;
     PostProcessor::new(robot, params.clone())
-        .process(&raw)
+        .process(&raw.on_surfaces(surfaces))
         .map_err(WalkError::PostProcess)
 }
 
