@@ -1,5 +1,5 @@
 //! Criterion benchmark of post-processing (the Table I workload at 25 m) and of its two parts,
-//! forward kinematics of the raw stances and the nine passes, to show what dominates.
+//! forward kinematics of the raw stances and the passes, to show what dominates.
 //! `walkctl bench-postprocess` prints the full Table I.
 
 use std::hint::black_box;
@@ -52,7 +52,12 @@ fn bench_robot(c: &mut Criterion, name: &str) {
     group.bench_function("passes", |b| {
         b.iter(|| {
             work.clone_from(&poses);
-            run_passes(black_box(&mut work), raw.environment(), &params);
+            run_passes(
+                black_box(&mut work),
+                raw.environment(),
+                &params,
+                &robot.sole,
+            );
         })
     });
     group.finish();

@@ -1,7 +1,7 @@
 //! Quantities derived from a sequence's world poses (DESIGN.md §3): steps `s_S`, swing heights
-//! `h_S`, orthogonal foot distances `o_S`. The walking direction is [`crate::passes::path_of`];
-//! roll/pitch/yaw is [`crate::geometry::roll_pitch_yaw`]. The passes' invariants are stated in
-//! these terms.
+//! `h_S` (above the higher of the swing's lift-off and landing surfaces), orthogonal foot
+//! distances `o_S`. The walking direction is [`crate::passes::path_of`]; roll/pitch/yaw is
+//! [`crate::geometry::roll_pitch_yaw`]. The passes' invariants are stated in these terms.
 
 use kinematics::robot::EndEffector;
 
@@ -60,17 +60,18 @@ pub fn orthogonal_distances(poses: &PoseSequence, path: &PathFrame) -> Vec<f64> 
         .collect()
 }
 
-/// Height of a swing foot above the surface below it.
+/// Height of a swing foot above the surface its height is measured from
+/// ([`swing_reference`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SwingHeight {
     /// The foot not in contact.
     pub foot: EndEffector,
-    /// Step height `h_S` above its surface.
+    /// Step height `h_S` above its reference surface.
     pub height: f64,
 }
 
-/// Step height `h_S` per stance: `Some` in single support (the swing foot's height above the
-/// surface under it, if any), `None` otherwise.
+/// Step height `h_S` per stance: `Some` in single support (the swing foot's height above its
+/// [`swing_reference`], if it has one), `None` otherwise.
 pub fn swing_heights(poses: &PoseSequence, environment: &Environment) -> Vec<Option<SwingHeight>> {
     (0..poses.len())
         .map(|i| {
@@ -82,13 +83,46 @@ pub fn swing_heights(poses: &PoseSequence, environment: &Environment) -> Vec<Opt
                 (false, true) => EndEffector::LeftFoot,
                 _ => return None,
             };
-            let p = poses.pose(i, swing).translation.vector;
-            environment.support_at(&p).map(|(_, z)| SwingHeight {
+            let z = poses.pose(i, swing).translation.z;
+            swing_reference(poses, environment, i, swing).map(|reference| SwingHeight {
                 foot: swing,
-                height: p.z - z,
+                height: z - reference,
             })
         })
         .collect()
+}
+
+/// The stances around a swing of `foot` through stance `i`: its last contact before (the
+/// lift-off) and its first contact after (the landing), where there are.
+pub(crate) fn swing_ends(poses: &PoseSequence, i: usize, foot: EndEffector) -> [Option<usize>; 2] {
+    [
+        (0..i).rev().find(|&j| poses.in_contact(j, foot)),
+        (i + 1..poses.len()).find(|&j| poses.in_contact(j, foot)),
+    ]
+}
+
+/// The elevation a swing foot's height is measured from in stance `i`: the higher of the
+/// surfaces under its lift-off and landing soles (on stairs the swing goes up to the higher
+/// tread, or starts from it, so a height above the surface under the foot would let it scrape
+/// the riser between them); the one of them it has at the start or end of a sequence; with
+/// neither, the surface under the foot. On flat ground all of these are the ground. `None`
+/// where none is over a surface.
+pub fn swing_reference(
+    poses: &PoseSequence,
+    environment: &Environment,
+    i: usize,
+    foot: EndEffector,
+) -> Option<f64> {
+    let under = |j: usize| {
+        environment
+            .support_at(&poses.pose(j, foot).translation.vector)
+            .map(|(_, z)| z)
+    };
+    let [lift, land] = swing_ends(poses, i, foot).map(|end| end.and_then(under));
+    match (lift, land) {
+        (Some(lift), Some(land)) => Some(lift.max(land)),
+        (lift, land) => lift.or(land).or_else(|| under(i)),
+    }
 }
 
 /// Stances `i` where `e` stays in contact from `i − 1` to `i` but its pose changes by more than

@@ -1,7 +1,7 @@
 //! The environment a sequence is planned in: planar support surfaces for the feet and hand
 //! affordances (e.g. a railing) with the interval of the path along which they are available.
 
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Vector2, Vector3};
 
 /// A planar support surface: its frame (z = surface normal, the plane is its xy plane) and the
 /// polygon of the supporting area in that plane. `polygon: None` is an unbounded plane (the
@@ -49,6 +49,69 @@ impl SupportSurface {
         let origin = self.pose.translation.vector;
         // n · (p − o) = 0 with p = (x, y, z) solved for z.
         Some(origin.z - (normal.x * (x - origin.x) + normal.y * (y - origin.y)) / normal.z)
+    }
+
+    /// The part of the horizontal line `from + t · direction` (world; z ignored) that lies over
+    /// the surface, as `[t_first, t_last]` (`±∞` for an unbounded plane); `None` if the line
+    /// misses the polygon, `direction` has no horizontal part or the surface is vertical. Exact
+    /// for convex polygons (a scene's rectangles): the terrain pass measures a surface's extent
+    /// along the walking path with it, and a swing's clearance over the surfaces it passes.
+    pub fn extent_along(&self, from: &Vector3<f64>, direction: &Vector3<f64>) -> Option<[f64; 2]> {
+        let Some(polygon) = &self.polygon else {
+            return self
+                .plane_elevation_at(from.x, from.y)
+                .map(|_| [f64::NEG_INFINITY, f64::INFINITY]);
+        };
+        let start = self.local_xy(from.x, from.y)?;
+        let step = self.local_xy(from.x + direction.x, from.y + direction.y)? - start;
+        let mut extent: Option<[f64; 2]> = None;
+        let mut previous = polygon[polygon.len() - 1];
+        for &vertex in polygon {
+            let (a, b) = (Vector2::from(previous), Vector2::from(vertex));
+            previous = vertex;
+            let edge = b - a;
+            let denominator = step.perp(&edge);
+            if denominator.abs() < 1e-12 {
+                continue;
+            }
+            let (t, u) = ((a - start).perp(&edge), (a - start).perp(&step));
+            let (t, u) = (t / denominator, u / denominator);
+            if (0.0..=1.0).contains(&u) {
+                extent = Some(extent.map_or([t, t], |[lo, hi]| [lo.min(t), hi.max(t)]));
+            }
+        }
+        extent.filter(|[lo, hi]| lo < hi)
+    }
+
+    /// The highest elevation (world z) of the surface under the horizontal segment from `from`
+    /// to `to` (world; z ignored); `None` if the segment does not pass over it. A swing foot
+    /// must clear it (pass 9).
+    pub fn highest_under(&self, from: &Vector3<f64>, to: &Vector3<f64>) -> Option<f64> {
+        let direction = to - from;
+        if direction.xy().norm() < 1e-12 {
+            return self.elevation_at(from.x, from.y);
+        }
+        let [lo, hi] = self.extent_along(from, &direction)?;
+        let (lo, hi) = (lo.max(0.0), hi.min(1.0));
+        if lo > hi {
+            return None;
+        }
+        // The plane's elevation is affine along a straight line: highest at an end.
+        let at =
+            |t: f64| self.plane_elevation_at(from.x + t * direction.x, from.y + t * direction.y);
+        Some(at(lo)?.max(at(hi)?))
+    }
+
+    /// Coordinates, in the surface frame's xy plane, of the point of the plane vertically
+    /// below/above the world point `(x, y)`; `None` if the surface is vertical.
+    fn local_xy(&self, x: f64, y: f64) -> Option<Vector2<f64>> {
+        let z = self.plane_elevation_at(x, y)?;
+        Some(
+            self.pose
+                .inverse_transform_point(&Point3::new(x, y, z))
+                .xy()
+                .coords,
+        )
     }
 }
 
@@ -108,6 +171,15 @@ impl Environment {
             .filter_map(|s| s.elevation_at(point.x, point.y).map(|z| (s, z)))
             .min_by(|(_, a), (_, b)| (point.z - a).abs().total_cmp(&(point.z - b).abs()))
     }
+
+    /// The highest surface (world z) under the horizontal segment from `from` to `to`; `None`
+    /// if it passes over none. What a swing foot passing there must clear (pass 9).
+    pub fn highest_under(&self, from: &Vector3<f64>, to: &Vector3<f64>) -> Option<f64> {
+        self.surfaces
+            .iter()
+            .filter_map(|s| s.highest_under(from, to))
+            .max_by(f64::total_cmp)
+    }
 }
 
 #[cfg(test)]
@@ -138,6 +210,75 @@ mod tests {
         assert_eq!((on_step.name.as_str(), z), ("step", 0.2));
         let (outside, z) = env.support_at(&Vector3::new(1.7, 0.1, 0.17)).unwrap();
         assert_eq!((outside.name.as_str(), z), ("ground", 0.0));
+    }
+
+    /// A 0.3 m tread along x at elevation 0.2, turned by `yaw` about z.
+    fn tread(yaw: f64) -> SupportSurface {
+        SupportSurface {
+            name: "tread".into(),
+            pose: Isometry3::from_parts(
+                Vector3::new(1.0, 0.0, 0.2).into(),
+                UnitQuaternion::from_euler_angles(0.0, 0.0, yaw),
+            ),
+            polygon: Some(vec![[-0.15, -0.5], [0.15, -0.5], [0.15, 0.5], [-0.15, 0.5]]),
+        }
+    }
+
+    #[test]
+    fn extent_along_a_line_is_where_it_crosses_the_polygon() {
+        let [lo, hi] = tread(0.0)
+            .extent_along(&Vector3::new(0.0, 0.1, 5.0), &Vector3::new(2.0, 0.0, 0.0))
+            .unwrap();
+        assert!(
+            (lo - 0.425).abs() < 1e-12 && (hi - 0.575).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        // Turned a quarter: 1 m long along x.
+        let [lo, hi] = tread(std::f64::consts::FRAC_PI_2)
+            .extent_along(&Vector3::new(0.0, 0.0, 0.0), &Vector3::x())
+            .unwrap();
+        assert!(
+            (lo - 0.5).abs() < 1e-12 && (hi - 1.5).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        assert_eq!(
+            tread(0.0).extent_along(&Vector3::new(0.0, 0.7, 0.0), &Vector3::x()),
+            None,
+            "passes beside it"
+        );
+        assert_eq!(
+            SupportSurface::ground().extent_along(&Vector3::zeros(), &Vector3::x()),
+            Some([f64::NEG_INFINITY, f64::INFINITY])
+        );
+    }
+
+    #[test]
+    fn highest_under_a_segment_is_the_highest_surface_it_passes() {
+        let env = Environment {
+            surfaces: vec![SupportSurface::ground(), tread(0.0)],
+            hand_affordances: Vec::new(),
+        };
+        let z = |a: f64, b: f64| {
+            env.highest_under(&Vector3::new(a, 0.0, 0.0), &Vector3::new(b, 0.0, 0.0))
+        };
+        assert_eq!(z(0.0, 2.0), Some(0.2), "over the tread");
+        assert_eq!(z(0.0, 0.8), Some(0.0), "stops short of it");
+        assert_eq!(z(0.9, 0.9), Some(0.2), "a point on it");
+        let ramp = SupportSurface {
+            name: "ramp".into(),
+            pose: Isometry3::from_parts(
+                Vector3::zeros().into(),
+                UnitQuaternion::from_euler_angles(0.0, -0.1, 0.0),
+            ),
+            polygon: Some(vec![[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]),
+        };
+        let top = ramp
+            .highest_under(&Vector3::new(-3.0, 0.0, 0.0), &Vector3::new(3.0, 0.0, 0.0))
+            .unwrap();
+        assert!(
+            (top - 0.1f64.sin()).abs() < 1e-12,
+            "the ramp's upper edge: {top}"
+        );
     }
 
     #[test]

@@ -89,6 +89,13 @@ impl PathFrame {
     pub fn lateral(&self, point: &Vector3<f64>) -> f64 {
         (point - self.origin).dot(&self.lateral)
     }
+
+    /// The point on the ground plane (z = 0) `along` the path and `lateral` to its left: the
+    /// inverse of [`PathFrame::along`] and [`PathFrame::lateral`], e.g. the start of a line
+    /// parallel to the path.
+    pub fn point(&self, along: f64, lateral: f64) -> Vector3<f64> {
+        self.origin + self.direction * along + self.lateral * lateral
+    }
 }
 
 #[cfg(test)]
@@ -114,6 +121,7 @@ mod tests {
         let p = Vector3::new(0.5, 2.0, 0.0);
         assert!((frame.along(&p) - 1.0).abs() < 1e-12);
         assert!((frame.lateral(&p) - 0.5).abs() < 1e-12);
+        assert!((frame.point(1.0, 0.5) - p).norm() < 1e-12);
     }
 
     #[test]

@@ -4,8 +4,8 @@
 //! - [`Stance`], [`RawSequence`], [`PostProcessedSequence`], [`Environment`]: the data model,
 //!   validated on construction and read/written as versioned JSON ([`format`]).
 //! - [`PoseSequence`]: world poses of root and end-effectors per stance, the passes' working form.
-//! - [`passes`]: the nine passes, each a function; [`PostProcessor`] runs FK + all passes with
-//!   reusable buffers.
+//! - [`passes`]: Algorithm 1's nine passes and the terrain pass, each a function;
+//!   [`PostProcessor`] runs FK + all passes with reusable buffers.
 //! - [`generate()`]: a human-like, impeded stance source; `learned` (feature `learned`): the
 //!   n-gram model trained on human demonstrations.
 //! - [`Scene`] ([`scene`]): a versioned TOML scene file (surfaces, railings, start and goal),

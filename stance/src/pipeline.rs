@@ -1,5 +1,6 @@
-//! Post-processing as one call: forward kinematics of the raw stances into world poses, the nine
-//! passes, and the post-processed sequence — with buffers reused across calls.
+//! Post-processing as one call: forward kinematics of the raw stances into world poses, the
+//! passes (Algorithm 1's nine and the terrain pass), and the post-processed sequence — with
+//! buffers reused across calls.
 
 use kinematics::robot::{EndEffector, Robot};
 use kinematics::{Configuration, FrameSet, Kinematics};
@@ -81,7 +82,12 @@ impl<'r> PostProcessor<'r> {
         out: &mut PostProcessedSequence,
     ) -> Result<(), FormatError> {
         self.forward_kinematics(raw)?;
-        run_passes(&mut self.poses, raw.environment(), &self.params);
+        run_passes(
+            &mut self.poses,
+            raw.environment(),
+            &self.params,
+            &self.robot.sole,
+        );
         out.assign(raw, &self.poses);
         out.gait = Some(self.params.gait);
         Ok(())
@@ -94,7 +100,13 @@ impl<'r> PostProcessor<'r> {
         after: impl FnMut(Pass, &PoseSequence),
     ) -> Result<PostProcessedSequence, FormatError> {
         self.forward_kinematics(raw)?;
-        run_passes_observed(&mut self.poses, raw.environment(), &self.params, after);
+        run_passes_observed(
+            &mut self.poses,
+            raw.environment(),
+            &self.params,
+            &self.robot.sole,
+            after,
+        );
         let mut out = PostProcessedSequence::empty();
         out.assign(raw, &self.poses);
         out.gait = Some(self.params.gait);

@@ -122,11 +122,7 @@ fn draw_top(
         );
         let mut chart = ChartBuilder::on(area)
             .caption(
-                format!(
-                    "after line {} of Algorithm 1: {}",
-                    snapshot.pass.line(),
-                    snapshot.pass.name()
-                ),
+                format!("after {}", caption(snapshot.pass)),
                 ("sans-serif", 16),
             )
             .margin(8)
@@ -163,6 +159,14 @@ fn draw_top(
 /// One series of the side view: the pass, its colour, (along path, height) points.
 type SideSeries = (Pass, RGBColor, Vec<(f64, f64)>);
 
+/// `line 9 of Algorithm 1: limitOrthogonalFeetDistance`, or the name of a pass not in it.
+fn caption(pass: Pass) -> String {
+    match pass.line() {
+        Some(line) => format!("line {line} of Algorithm 1: {}", pass.name()),
+        None => pass.name().to_owned(),
+    }
+}
+
 /// The passes whose swing heights the side view shows: the raw heights on the floor, after the
 /// step-size limits, and the result.
 const SIDE_VIEW: [(Pass, RGBColor); 3] = [
@@ -187,7 +191,7 @@ fn draw_side(
                 .map(|s| (pass, colour, &s.poses))
         })
         .map(|(pass, colour, poses)| {
-            let points = crate::derived::swing_heights(poses, environment)
+            let points = crate::derived::swing_heights(poses, pass.environment(environment))
                 .iter()
                 .enumerate()
                 .filter_map(|(i, h)| {
@@ -238,7 +242,7 @@ fn draw_side(
     for (pass, colour, points) in series {
         chart
             .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))?
-            .label(format!("after line {} ({})", pass.line(), pass.name()))
+            .label(format!("after {}", caption(pass)))
             .legend(move |(x, y)| Circle::new((x, y), 3, colour.filled()));
     }
     chart

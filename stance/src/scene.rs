@@ -327,6 +327,45 @@ impl Scene {
         let dto = parsed.map_err(|error| toml_error(text, origin, &error))?;
         Validator { origin }.scene(dto)
     }
+
+    /// The scene's surfaces and railings in the frame of [`Scene::start`]: the start at the
+    /// origin on z = 0, heading +x. Stance sources generate a walk there, on flat ground; with
+    /// this environment attached, post-processing fits it to the scene
+    /// ([`crate::passes::place_on_terrain`]). Railing availability (metres along the path) is
+    /// kept: the path starts at the start either way.
+    pub fn walk_environment(&self) -> Environment {
+        let to_walk = self.start.inverse();
+        Environment {
+            surfaces: self
+                .environment
+                .surfaces
+                .iter()
+                .map(|surface| SupportSurface {
+                    pose: to_walk * surface.pose,
+                    ..surface.clone()
+                })
+                .collect(),
+            hand_affordances: self
+                .environment
+                .hand_affordances
+                .iter()
+                .map(|railing| HandAffordance {
+                    start: to_walk.transform_point(&railing.start.into()).coords,
+                    end: to_walk.transform_point(&railing.end.into()).coords,
+                    ..railing.clone()
+                })
+                .collect(),
+        }
+    }
+
+    /// How far the walk goes: the horizontal distance from the start to the goal along the
+    /// start's heading. A walk for the scene is asked for this distance (generated for
+    /// `path_length / scf`, like any walk of a given length).
+    pub fn path_length(&self) -> f64 {
+        let heading = self.start.rotation * Vector3::x();
+        let to_goal = self.goal - self.start.translation.vector;
+        to_goal.xy().dot(&heading.xy())
+    }
 }
 
 /// A located [`SceneError::Toml`] from a `toml` error.
@@ -731,4 +770,80 @@ fn overlap_depth(a: &[Vector2<f64>], b: &[Vector2<f64>]) -> f64 {
             a_hi.min(b_hi) - a_lo.max(b_lo)
         })
         .fold(f64::INFINITY, f64::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn committed(name: &str) -> Scene {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../configs/scenes")
+            .join(format!("{name}.toml"));
+        Scene::from_path(&path).unwrap()
+    }
+
+    #[test]
+    fn the_walk_environment_starts_at_the_origin() {
+        let scene = committed("stairs-down-10cm");
+        let env = scene.walk_environment();
+        // The walk starts on the landing (z = 1 m in the scene), 1 m before its edge.
+        let (start, z) = env.support_at(&Vector3::zeros()).unwrap();
+        assert_eq!((start.name.as_str(), z), ("landing", 0.0));
+        let (floor, z) = env.support_at(&Vector3::new(4.7, 0.0, -1.0)).unwrap();
+        assert_eq!(floor.name, "floor");
+        assert!((z + 1.0).abs() < 1e-12, "{z}");
+        let lowest = env
+            .surfaces
+            .iter()
+            .map(|s| s.pose.translation.z)
+            .fold(f64::INFINITY, f64::min);
+        assert!((lowest + 1.0).abs() < 1e-12, "{lowest}");
+        // The first riser down, 1 m ahead.
+        assert!(
+            env.support_at(&Vector3::new(0.99, 0.0, 0.0))
+                .unwrap()
+                .0
+                .name
+                == "landing"
+        );
+        assert!(
+            env.support_at(&Vector3::new(1.01, 0.0, 0.0))
+                .unwrap()
+                .0
+                .name
+                == "tread-9"
+        );
+    }
+
+    #[test]
+    fn the_walk_environment_turns_with_the_start_and_keeps_the_railings() {
+        let mut scene = committed("railing");
+        scene.start = Isometry3::from_parts(
+            Translation3::new(1.0, 0.0, 0.0),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f64::consts::FRAC_PI_2),
+        );
+        let env = scene.walk_environment();
+        let railing = &env.hand_affordances[0];
+        let original = &scene.environment.hand_affordances[0];
+        // Facing world +y from (1, 0): walk x = world y, walk y = 1 − world x.
+        assert!(
+            (railing.start - Vector3::new(-0.45, 1.5, 0.8)).norm() < 1e-12,
+            "{railing:?}"
+        );
+        assert!(
+            (railing.end - Vector3::new(-0.45, -4.5, 0.8)).norm() < 1e-12,
+            "{railing:?}"
+        );
+        assert_eq!(railing.available, original.available);
+    }
+
+    #[test]
+    fn the_path_length_is_measured_along_the_start_heading() {
+        let scene = committed("stairs-down-10cm");
+        assert!((scene.path_length() - 4.7).abs() < 1e-12);
+        let mut turned = scene.clone();
+        turned.start.rotation = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.5);
+        assert!((turned.path_length() - 4.7 * 0.5f64.cos()).abs() < 1e-12);
+    }
 }

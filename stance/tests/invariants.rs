@@ -158,7 +158,7 @@ fn check_idempotent(
         .map_err(|e| TestCaseError::fail(e.to_string()))?;
     let once = out.to_poses();
     let mut twice = once.clone();
-    run_passes(&mut twice, raw.environment(), &params);
+    run_passes(&mut twice, raw.environment(), &params, &robot.sole);
     for i in 0..once.len() {
         prop_assert!(
             (once.roots[i].translation.vector - twice.roots[i].translation.vector).norm() < EPS

@@ -1,14 +1,23 @@
 //! Pass 9: swing-foot height.
 
+use kinematics::robot::EndEffector;
+use nalgebra::{Isometry3, Point3};
+
+use crate::derived::{swing_ends, swing_reference};
 use crate::environment::Environment;
 use crate::poses::{FEET, PoseSequence};
 
 /// Pass 9, `limitSwingFootHeight(h_min, h_max)`: clamps the height of every foot not in contact
-/// above the surface below it to `[h_min, h_max]` (`h_min` keeps it clear of the ground, `h_max`
-/// removes unnaturally high swings). Feet over no surface are left as is.
+/// to `[h_min, h_max]` (`h_min` keeps it clear of the ground, `h_max` removes unnaturally high
+/// swings). The height is measured from the higher of the surfaces under the swing's lift-off
+/// and landing soles ([`swing_reference`]; on flat ground, the ground under the foot), and the
+/// foot also stays `h_min` above every surface the swing passes over (`swing_clearance`: a
+/// stair nosing or ramp edge between the two footholds, higher than both), even where that is
+/// above `h_max`. Feet with no surface to measure from are left as is.
 pub fn limit_swing_foot_height(
     poses: &mut PoseSequence,
     environment: &Environment,
+    sole_length: f64,
     h_min: f64,
     h_max: f64,
 ) {
@@ -17,22 +26,52 @@ pub fn limit_swing_foot_height(
             if poses.in_contact(i, foot) {
                 continue;
             }
+            let Some(reference) = swing_reference(poses, environment, i, foot) else {
+                continue;
+            };
+            let clearance = swing_clearance(poses, environment, sole_length, i, foot)
+                .map_or(reference, |c| c.max(reference));
+            let lowest = (clearance - reference) + h_min;
             let p = &mut poses.end_effectors[i][foot as usize].translation.vector;
-            if let Some((_, z)) = environment.support_at(p) {
-                let height = p.z - z;
-                let clamped = height.clamp(h_min, h_max);
-                if clamped != height {
-                    p.z = z + clamped;
-                }
+            let height = p.z - reference;
+            let clamped = height.clamp(lowest, h_max.max(lowest));
+            if clamped != height {
+                p.z = reference + clamped;
             }
         }
     }
 }
 
+/// The highest surface a swing of `foot` through stance `i` passes over: under its lift-off
+/// sole (heel to toe), the straight line from the lift-off to the landing sole centre, and
+/// the landing sole; only the ends it has. `None` without either end or over no surface.
+fn swing_clearance(
+    poses: &PoseSequence,
+    environment: &Environment,
+    sole_length: f64,
+    i: usize,
+    foot: EndEffector,
+) -> Option<f64> {
+    let [lift, land] = swing_ends(poses, i, foot).map(|end| end.map(|j| poses.pose(j, foot)));
+    let sole = |pose: &Isometry3<f64>| {
+        [-0.5, 0.5].map(|s| (pose * Point3::new(s * sole_length, 0.0, 0.0)).coords)
+    };
+    let centres = lift
+        .zip(land)
+        .map(|(a, b)| [a.translation.vector, b.translation.vector]);
+    lift.map(sole)
+        .into_iter()
+        .chain(land.map(sole))
+        .chain(centres)
+        .filter_map(|[from, to]| environment.highest_under(&from, &to))
+        .max_by(f64::total_cmp)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::passes::fixtures::{BOTH, LEFT, RIGHT, stance, walk};
+    use crate::environment::SupportSurface;
+    use crate::passes::fixtures::{BOTH, LEFT, RIGHT, SOLE, block, stance, walk};
     use kinematics::robot::EndEffector::{LeftFoot, RightFoot};
 
     #[test]
@@ -42,7 +81,7 @@ mod tests {
             stance([0.1, 0.1, 0.01], [0.2, -0.1, 0.0], RIGHT),
             stance([0.1, 0.1, 0.05], [0.2, -0.1, 0.0], BOTH),
         ]);
-        limit_swing_foot_height(&mut p, &Environment::default(), 0.03, 0.1);
+        limit_swing_foot_height(&mut p, &Environment::default(), SOLE.length, 0.03, 0.1);
         assert!((p.pose(0, RightFoot).translation.z - 0.1).abs() < 1e-12);
         assert!((p.pose(1, LeftFoot).translation.z - 0.03).abs() < 1e-12);
         assert_eq!(p.pose(2, LeftFoot).translation.z, 0.05);
@@ -52,7 +91,55 @@ mod tests {
     fn swing_foot_inside_the_limits_is_untouched() {
         let mut p = walk(&[stance([0.0, 0.1, 0.0], [0.2, -0.1, 0.07], LEFT)]);
         let before = p.clone();
-        limit_swing_foot_height(&mut p, &Environment::default(), 0.03, 0.1);
+        limit_swing_foot_height(&mut p, &Environment::default(), SOLE.length, 0.03, 0.1);
         assert_eq!(p, before);
+    }
+
+    /// Ground, and a block `height` high whose top spans x from `from` to `to`.
+    fn with_block(from: f64, to: f64, height: f64) -> Environment {
+        Environment {
+            surfaces: vec![SupportSurface::ground(), block("block", from, to, height)],
+            hand_affordances: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_step_up_is_measured_from_the_higher_surface() {
+        // The right foot steps from the ground onto a 0.1 m block starting at x = 0.5; mid-swing
+        // it is over the ground, 0.08 m high: 0.02 below the block's top.
+        let env = with_block(0.5, 1.5, 0.1);
+        let mut p = walk(&[
+            stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH),
+            stance([0.0, 0.1, 0.0], [0.3, -0.1, 0.08], LEFT),
+            stance([0.0, 0.1, 0.0], [0.7, -0.1, 0.1], BOTH),
+        ]);
+        limit_swing_foot_height(&mut p, &env, SOLE.length, 0.03, 0.06);
+        assert!((p.pose(1, RightFoot).translation.z - 0.13).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_swing_clears_a_surface_higher_than_both_footholds() {
+        // A 0.1 m bump between x = 0.3 and 0.4 under a step from x = 0 to 0.7 on the ground.
+        let env = with_block(0.3, 0.4, 0.1);
+        let mut p = walk(&[
+            stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH),
+            stance([0.0, 0.1, 0.0], [0.35, -0.1, 0.05], LEFT),
+            stance([0.0, 0.1, 0.0], [0.7, -0.1, 0.0], BOTH),
+        ]);
+        assert_eq!(
+            swing_clearance(&p, &env, SOLE.length, 1, RightFoot),
+            Some(0.1)
+        );
+        limit_swing_foot_height(&mut p, &env, SOLE.length, 0.03, 0.06);
+        assert!(
+            (p.pose(1, RightFoot).translation.z - 0.13).abs() < 1e-12,
+            "h_min above the bump, over h_max above the ground"
+        );
+        // The landing sole's toe (x = 0.8) over the bump's start counts too.
+        let env = with_block(0.79, 1.0, 0.1);
+        assert_eq!(
+            swing_clearance(&p, &env, SOLE.length, 1, RightFoot),
+            Some(0.1)
+        );
     }
 }

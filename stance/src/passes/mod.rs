@@ -1,24 +1,31 @@
-//! Algorithm 1: the nine post-processing passes (DESIGN.md §4), each a function on a
-//! [`PoseSequence`], and [`run_passes`], which composes them in the paper's order.
+//! Algorithm 1: the nine post-processing passes (DESIGN.md §4) and the terrain pass that puts
+//! the walk on its surfaces (DESIGN.md §11), each a function on a [`PoseSequence`], and
+//! [`run_passes`], which composes them in the paper's order with the terrain pass after pass 8.
 
 mod contacts;
 mod elevation;
 mod height;
 mod orientation;
 mod path;
+mod terrain;
+
+use std::sync::LazyLock;
 
 pub use contacts::unify_contacts;
 pub use elevation::{contact_feet_to_surface_elevation, move_stances_up};
 pub use height::limit_swing_foot_height;
 pub use orientation::{contact_feet_parallel_to_surface, limit_swing_foot_rotation};
 pub use path::{limit_orthogonal_feet_distance, limit_to_max_step_size, scale_translation};
+pub use terrain::{HEEL_MARGIN_M, SHORT_SURFACE_SOLES, TOE_MARGIN_M, place_on_terrain};
+
+use kinematics::robot::SoleRectangle;
 
 use crate::environment::Environment;
 use crate::geometry::PathFrame;
 use crate::params::PostProcessParams;
 use crate::poses::{FEET, PoseSequence};
 
-/// The passes of Algorithm 1 in execution order (lines 2–10).
+/// The passes in execution order: Algorithm 1's (lines 2–10) with the terrain pass after line 9.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Pass {
     /// Line 2, [`move_stances_up`].
@@ -37,13 +44,15 @@ pub enum Pass {
     LimitToMaxStepSize,
     /// Line 9, [`limit_orthogonal_feet_distance`].
     LimitOrthogonalFeetDistance,
+    /// Not in Algorithm 1: [`place_on_terrain`].
+    PlaceOnTerrain,
     /// Line 10, [`limit_swing_foot_height`].
     LimitSwingFootHeight,
 }
 
 impl Pass {
     /// All passes in order.
-    pub const ALL: [Pass; 9] = [
+    pub const ALL: [Pass; 10] = [
         Pass::MoveStancesUp,
         Pass::UnifyContacts,
         Pass::ContactFeetParallelToSurface,
@@ -52,10 +61,11 @@ impl Pass {
         Pass::ScaleTranslation,
         Pass::LimitToMaxStepSize,
         Pass::LimitOrthogonalFeetDistance,
+        Pass::PlaceOnTerrain,
         Pass::LimitSwingFootHeight,
     ];
 
-    /// The paper's name of the pass.
+    /// The paper's name of the pass (ours for the terrain pass).
     pub fn name(self) -> &'static str {
         match self {
             Pass::MoveStancesUp => "moveStancesUp",
@@ -66,14 +76,38 @@ impl Pass {
             Pass::ScaleTranslation => "scaleTranslation",
             Pass::LimitToMaxStepSize => "limitToMaxStepSize",
             Pass::LimitOrthogonalFeetDistance => "limitOrthogonalFeetDistance",
+            Pass::PlaceOnTerrain => "placeOnTerrain",
             Pass::LimitSwingFootHeight => "limitSwingFootHeight",
         }
     }
 
-    /// Line of Algorithm 1 that runs the pass.
-    pub fn line(self) -> usize {
-        self as usize + 2
+    /// Line of Algorithm 1 that runs the pass; `None` for the terrain pass, which the paper
+    /// does not have.
+    pub fn line(self) -> Option<usize> {
+        match self {
+            Pass::PlaceOnTerrain => None,
+            Pass::LimitSwingFootHeight => Some(10),
+            earlier => Some(earlier as usize + 2),
+        }
     }
+
+    /// The environment the pass works in, so its result lies on: the flat ground the raw walk
+    /// was generated on (the plane z = 0 through its start) before the terrain pass, `walk`
+    /// (the sequence's own) from it on.
+    pub fn environment(self, walk: &Environment) -> &Environment {
+        match self {
+            Pass::PlaceOnTerrain | Pass::LimitSwingFootHeight => walk,
+            _ => flat_ground(),
+        }
+    }
+}
+
+/// The ground plane z = 0 through the start of a walk, where every stance source generates it:
+/// passes 1–5 work on it whatever the walk's environment ([`Pass::environment`]), as the raw
+/// walk is still at the human-to-robot scale that pass 6 changes.
+fn flat_ground() -> &'static Environment {
+    static FLAT: LazyLock<Environment> = LazyLock::new(Environment::default);
+    &FLAT
 }
 
 /// The walking path of a pose sequence (see [`PathFrame`]): from the first root along the mean
@@ -88,9 +122,16 @@ pub fn path_of(poses: &PoseSequence) -> Option<PathFrame> {
     Some(PathFrame::of_walk(&origin, contact_feet))
 }
 
-/// Runs the nine passes in order on `poses`. Allocation-free.
-pub fn run_passes(poses: &mut PoseSequence, environment: &Environment, params: &PostProcessParams) {
-    run_passes_observed(poses, environment, params, |_, _| {});
+/// Runs the passes in order on `poses`, a walk generated on the flat ground at the origin and
+/// meant for `environment` (in the walk's frame); `sole` is the robot's. Allocation-free (after
+/// the first call).
+pub fn run_passes(
+    poses: &mut PoseSequence,
+    environment: &Environment,
+    params: &PostProcessParams,
+    sole: &SoleRectangle,
+) {
+    run_passes_observed(poses, environment, params, sole, |_, _| {});
 }
 
 /// [`run_passes`], calling `after` with each pass and the poses it produced (for Fig. 3).
@@ -98,22 +139,24 @@ pub fn run_passes_observed(
     poses: &mut PoseSequence,
     environment: &Environment,
     params: &PostProcessParams,
+    sole: &SoleRectangle,
     mut after: impl FnMut(Pass, &PoseSequence),
 ) {
     if poses.is_empty() {
         return;
     }
-    move_stances_up(poses, environment);
+    let flat = flat_ground();
+    move_stances_up(poses, flat);
     after(Pass::MoveStancesUp, poses);
     unify_contacts(poses, params.contact_unification);
     after(Pass::UnifyContacts, poses);
-    contact_feet_parallel_to_surface(poses, environment);
+    contact_feet_parallel_to_surface(poses, flat);
     after(Pass::ContactFeetParallelToSurface, poses);
-    contact_feet_to_surface_elevation(poses, environment);
+    contact_feet_to_surface_elevation(poses, flat);
     after(Pass::ContactFeetToSurfaceElevation, poses);
     // The walking path, once the contacts are unified: no later pass changes a contact's yaw.
     let path = path_of(poses).expect("a non-empty sequence has a path");
-    limit_swing_foot_rotation(poses, environment, &path, params.alpha());
+    limit_swing_foot_rotation(poses, flat, &path, params.alpha());
     after(Pass::LimitSwingFootRotation, poses);
     scale_translation(poses, &path, params.scf);
     after(Pass::ScaleTranslation, poses);
@@ -121,17 +164,42 @@ pub fn run_passes_observed(
     after(Pass::LimitToMaxStepSize, poses);
     limit_orthogonal_feet_distance(poses, &path, params.o_min, params.o_max);
     after(Pass::LimitOrthogonalFeetDistance, poses);
-    limit_swing_foot_height(poses, environment, params.h_min, params.h_max);
+    place_on_terrain(poses, environment, &path, sole);
+    after(Pass::PlaceOnTerrain, poses);
+    limit_swing_foot_height(poses, environment, sole.length, params.h_min, params.h_max);
     after(Pass::LimitSwingFootHeight, poses);
 }
 
 /// Hand-made pose sequences for the passes' unit tests.
 #[cfg(test)]
 pub(crate) mod fixtures {
-    use kinematics::robot::EndEffector;
+    use kinematics::robot::{EndEffector, SoleRectangle};
     use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
+    use crate::environment::SupportSurface;
+    use crate::geometry::PathFrame;
     use crate::poses::PoseSequence;
+
+    /// A sole of JVRC-1's size.
+    pub const SOLE: SoleRectangle = SoleRectangle {
+        length: 0.2,
+        width: 0.08,
+    };
+
+    /// A walking path along +x from the origin.
+    pub fn x_path() -> PathFrame {
+        PathFrame::new(&Vector3::zeros(), &Vector3::x()).unwrap()
+    }
+
+    /// A horizontal surface 1 m wide from x = `from` to `to` at elevation `z`.
+    pub fn block(name: &str, from: f64, to: f64, z: f64) -> SupportSurface {
+        let half = (to - from) / 2.0;
+        SupportSurface {
+            name: name.into(),
+            pose: Isometry3::translation(from + half, 0.0, z),
+            polygon: Some(vec![[-half, -0.5], [half, -0.5], [half, 0.5], [-half, 0.5]]),
+        }
+    }
 
     pub const BOTH: [bool; 4] = [true, true, false, false];
     pub const LEFT: [bool; 4] = [true, false, false, false];
@@ -177,7 +245,7 @@ pub(crate) mod fixtures {
 
 #[cfg(test)]
 mod tests {
-    use super::fixtures::{BOTH, rotated, stance, walk};
+    use super::fixtures::{BOTH, SOLE, block, rotated, stance, walk};
     use super::*;
     use crate::geometry::roll_pitch_yaw;
     use crate::params::ContactUnification;
@@ -203,7 +271,7 @@ mod tests {
     fn single_stance_sequence_is_made_executable() {
         let mut p = walk(&[stance([0.0, 0.05, -0.2], [0.0, -0.05, -0.17], BOTH)]);
         rotated(&mut p, 0, LeftFoot, [0.2, 0.1, 0.3]);
-        run_passes(&mut p, &Environment::default(), &params());
+        run_passes(&mut p, &Environment::default(), &params(), &SOLE);
         for foot in [LeftFoot, RightFoot] {
             let pose = p.pose(0, foot);
             let [roll, pitch, _] = roll_pitch_yaw(&pose.rotation);
@@ -218,13 +286,39 @@ mod tests {
 
     #[test]
     fn passes_run_in_the_papers_order() {
-        let lines: Vec<usize> = Pass::ALL.iter().map(|p| p.line()).collect();
+        let lines: Vec<usize> = Pass::ALL.iter().filter_map(|p| p.line()).collect();
         assert_eq!(lines, (2..=10).collect::<Vec<_>>());
         let mut seen = Vec::new();
         let mut p = walk(&[stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH)]);
-        run_passes_observed(&mut p, &Environment::default(), &params(), |pass, _| {
-            seen.push(pass)
-        });
+        run_passes_observed(
+            &mut p,
+            &Environment::default(),
+            &params(),
+            &SOLE,
+            |pass, _| seen.push(pass),
+        );
         assert_eq!(seen, Pass::ALL);
+        let terrain = Pass::ALL.iter().position(|&p| p == Pass::PlaceOnTerrain);
+        assert_eq!(terrain, Some(8), "after pass 8, before pass 9");
+    }
+
+    /// Passes 1–5 work on the flat ground whatever the walk's environment: the walk is
+    /// generated there.
+    #[test]
+    fn passes_before_the_terrain_pass_work_on_the_flat_ground() {
+        let env = Environment {
+            surfaces: vec![block("step", -1.0, 1.0, 0.1)],
+            hand_affordances: Vec::new(),
+        };
+        let mut p = walk(&[stance([0.0, 0.1, -0.2], [0.0, -0.1, -0.2], BOTH)]);
+        run_passes_observed(&mut p, &env, &params(), &SOLE, |pass, poses| {
+            let z = poses.pose(0, LeftFoot).translation.z;
+            let expected = if pass.environment(&env) == &env {
+                0.1
+            } else {
+                0.0
+            };
+            assert_eq!(z, expected, "after {}", pass.name());
+        });
     }
 }

@@ -29,7 +29,7 @@ pub fn contact_feet_parallel_to_surface(poses: &mut PoseSequence, environment: &
 /// `rotation` with its roll and pitch relative to `surface` removed and its yaw kept: the frame
 /// whose z is the surface normal and whose x is the foot's x projected onto the surface plane
 /// (trigonometry-free). `None` if the foot's x is along the normal (no yaw to keep).
-fn flattened(
+pub(super) fn flattened(
     surface: &UnitQuaternion<f64>,
     rotation: &UnitQuaternion<f64>,
 ) -> Option<UnitQuaternion<f64>> {

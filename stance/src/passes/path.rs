@@ -1,7 +1,8 @@
-//! Passes 6–8: step geometry along and across the walking path.
+//! Passes 6–8: step geometry along and across the walking path, and the landing shifts pass 7
+//! and the terrain pass share.
 
 use kinematics::robot::EndEffector;
-use nalgebra::Vector3;
+use nalgebra::{Isometry3, Vector3};
 
 use crate::geometry::PathFrame;
 use crate::poses::{FEET, HANDS, PoseSequence};
@@ -35,24 +36,86 @@ fn next_contact(poses: &PoseSequence, e: EndEffector, from: usize) -> Option<usi
 
 /// Pass 7, `limitToMaxStepSize(s_max)`: shortens every step still longer than `s_max` (the
 /// along-path distance between consecutive contacts of one foot; backward steps alike) to
-/// exactly `s_max`. Everything after a shortened step moves back with it: the landing and all
-/// later contact runs, the roots and free end-effectors of later stances. A contact run moves as
-/// a whole (by the shift at its first stance), so no contact jumps; a swing foot's shift is
-/// interpolated between its lift-off and landing shifts. The covered distance shrinks.
+/// exactly `s_max`. Everything after a shortened step moves back with it (see
+/// `shift_landings`): the landing and all later contact runs, the roots and free
+/// end-effectors of later stances. The covered distance shrinks.
 pub fn limit_to_max_step_size(poses: &mut PoseSequence, path: &PathFrame, s_max: f64) {
-    let mut state = StepLimit {
+    shift_landings(
+        poses,
         path,
-        s_max,
+        &mut StepLimit {
+            s_max,
+            last_contact_along: [None; 2],
+        },
+    );
+}
+
+/// Pass 7's landing rule: a landing moves back by the part of its step beyond `s_max`.
+struct StepLimit {
+    s_max: f64,
+    /// Shifted along-path position of each foot's last contact.
+    last_contact_along: [Option<f64>; 2],
+}
+
+impl LandingRule for StepLimit {
+    type Placed = ();
+
+    fn place(&self, f: usize, along: f64, _sole: &Isometry3<f64>) -> (f64, ()) {
+        let correction =
+            self.last_contact_along[f].map_or(0.0, |previous| excess(along - previous, self.s_max));
+        (-correction, ())
+    }
+
+    fn landed(&mut self, f: usize, along: f64, _placed: ()) {
+        self.last_contact_along[f] = Some(along);
+    }
+}
+
+/// Where a foot's landing goes along the walking path: the rule [`shift_landings`] applies to
+/// every landing. Pass 7 shortens long steps with one, the terrain pass fits footholds to their
+/// surfaces with another; the shifting itself (what moves with a landing) is the same.
+pub(crate) trait LandingRule {
+    /// What the rule decided about a landing besides its shift (the terrain pass: the surface
+    /// it lands on), handed back to [`LandingRule::landed`].
+    type Placed: Copy;
+
+    /// The along-path move of foot `f` (0 left, 1 right) landing with its sole centre at
+    /// `along` (its position after the shifts of the landings before it); `sole` is the
+    /// landing's pose before those shifts (its lateral offset and rotation hold). It may be
+    /// asked again for the same landing while the foot swings towards it, so it only reads the
+    /// rule's state.
+    fn place(&self, f: usize, along: f64, sole: &Isometry3<f64>) -> (f64, Self::Placed);
+
+    /// Foot `f` landed at `along` (shifted, final) with what [`LandingRule::place`] decided;
+    /// called after every landing of the stance was placed.
+    fn landed(&mut self, f: usize, along: f64, placed: Self::Placed);
+}
+
+/// Applies `rule` to every landing in order of touchdown: a landing's along-path shift moves
+/// that contact run and everything after it with it (later contact runs, the roots and free
+/// end-effectors of later stances), so shifts accumulate along the walk. A contact run moves as
+/// a whole (by the shift at its first stance), so no contact jumps; a swinging foot's shift is
+/// interpolated (by stance index) between its lift-off shift and the shift its landing will
+/// get. Heights and lateral offsets are kept.
+pub(crate) fn shift_landings<R: LandingRule>(
+    poses: &mut PoseSequence,
+    path: &PathFrame,
+    rule: &mut R,
+) {
+    let mut state = Running {
+        path,
+        rule,
         shift: 0.0,
         run_shift: [0.0; 4],
         last_run_end: [None; 4],
-        last_contact_along: [None; 2],
     };
     for i in 0..poses.len() {
+        let mut placed = [None; 2];
         for (f, &foot) in FEET.iter().enumerate() {
             if poses.contact_starts(i, foot) {
-                let along = path.along(&poses.pose(i, foot).translation.vector) + state.shift;
-                state.shift -= state.landing_correction(f, along);
+                let (delta, decision) = state.place(poses, f, i);
+                state.shift += delta;
+                placed[f] = Some(decision);
             }
         }
         for e in EndEffector::ALL {
@@ -70,33 +133,34 @@ pub fn limit_to_max_step_size(poses: &mut PoseSequence, path: &PathFrame, s_max:
             }
         }
         for (f, &foot) in FEET.iter().enumerate() {
-            if poses.contact_starts(i, foot) {
-                state.last_contact_along[f] =
-                    Some(path.along(&poses.pose(i, foot).translation.vector));
+            if let Some(decision) = placed[f] {
+                let along = path.along(&poses.pose(i, foot).translation.vector);
+                state.rule.landed(f, along, decision);
             }
         }
         poses.roots[i].translation.vector += path.direction() * state.shift;
     }
 }
 
-/// Running state of pass 7 (along-path shifts), so the pass needs no allocation.
-struct StepLimit<'p> {
+/// Running state of [`shift_landings`] (along-path shifts), so it needs no allocation.
+struct Running<'p, 'r, R> {
     path: &'p PathFrame,
-    s_max: f64,
+    rule: &'r mut R,
     /// Shift of the current stance.
     shift: f64,
     /// Shift of each end-effector's current (or last) contact run.
     run_shift: [f64; 4],
     /// Last stance each end-effector was in contact.
     last_run_end: [Option<usize>; 4],
-    /// Shifted along-path position of each foot's last contact.
-    last_contact_along: [Option<f64>; 2],
 }
 
-impl StepLimit<'_> {
-    /// How much foot `f` landing at (shifted) `along` must move back for its step to fit.
-    fn landing_correction(&self, f: usize, along: f64) -> f64 {
-        self.last_contact_along[f].map_or(0.0, |previous| excess(along - previous, self.s_max))
+impl<R: LandingRule> Running<'_, '_, R> {
+    /// The rule's shift and decision for foot `f` landing in stance `land` (its raw pose moved
+    /// by the current shift).
+    fn place(&self, poses: &PoseSequence, f: usize, land: usize) -> (f64, R::Placed) {
+        let sole = poses.pose(land, FEET[f]);
+        let along = self.path.along(&sole.translation.vector) + self.shift;
+        self.rule.place(f, along, sole)
     }
 
     /// Shift of a free end-effector in stance `i`: for a foot between two contacts, interpolated
@@ -113,8 +177,7 @@ impl StepLimit<'_> {
         let Some(land) = next_contact(poses, e, i) else {
             return self.shift;
         };
-        let along = self.path.along(&poses.pose(land, e).translation.vector) + self.shift;
-        let landing_shift = self.shift - self.landing_correction(f, along);
+        let landing_shift = self.shift + self.place(poses, f, land).0;
         let lifted = self.run_shift[e as usize];
         lifted + (landing_shift - lifted) * (i - lift) as f64 / (land - lift) as f64
     }
@@ -206,12 +269,8 @@ fn mean_support_offset(poses: &PoseSequence, i: usize, run_offset: &[f64; 2]) ->
 mod tests {
     use super::*;
     use crate::derived::{orthogonal_distances, steps};
-    use crate::passes::fixtures::{BOTH, LEFT, RIGHT, stance, walk};
+    use crate::passes::fixtures::{BOTH, LEFT, RIGHT, stance, walk, x_path};
     use kinematics::robot::EndEffector::{LeftFoot, LeftHand, RightFoot, RightHand};
-
-    fn x_path() -> PathFrame {
-        PathFrame::new(&Vector3::zeros(), &Vector3::x()).unwrap()
-    }
 
     /// DS, SS(right swings), DS, SS(left swings), DS with the given landing x positions.
     fn gait(right_land: f64, left_land: f64) -> PoseSequence {

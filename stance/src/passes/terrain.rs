@@ -1,0 +1,536 @@
+//! The terrain pass: puts the flat walk of passes 1–8 onto the environment's surfaces.
+//!
+//! The raw walk is generated on flat ground, at the human-to-robot scale, and passes 1–5 keep
+//! it there; pass 6 scales it to the robot's steps and passes 7–8 fix step length and width.
+//! Only then are the footholds where they will be, so only then can they be fitted to the
+//! surfaces they land on: this pass, right after pass 8 and before pass 9 (which then measures
+//! swing heights on the real surfaces).
+
+use kinematics::robot::{EndEffector, SoleRectangle};
+use nalgebra::{Isometry3, Vector3};
+
+use super::orientation::flattened;
+use super::path::{LandingRule, shift_landings};
+use crate::derived::swing_reference;
+use crate::environment::{Environment, SupportSurface};
+use crate::geometry::PathFrame;
+use crate::poses::{FEET, HANDS, PoseSequence};
+
+/// Room (m) left between a foothold's heel and the back edge of its surface.
+pub const HEEL_MARGIN_M: f64 = 0.02;
+
+/// Room (m) left between a foothold's toe and the front edge of its surface: more than at the
+/// heel, because there the toe meets the next riser of a stair going up.
+pub const TOE_MARGIN_M: f64 = 0.03;
+
+/// A surface shorter than this many sole lengths along the path is *short* (a stair tread):
+/// two feet side by side fit on it, but a step from one to the other on it does not, so a
+/// walker puts one foot per stair.
+pub const SHORT_SURFACE_SOLES: f64 = 2.0;
+
+/// The terrain pass, `placeOnTerrain`: fits the flat walk's footholds to the surfaces of
+/// `environment` and lifts the walk onto them. Runs after pass 8 on poses that lie on the flat
+/// plane z = 0 through the start (the environment is expressed in the walk's frame, start at
+/// the origin: [`crate::Scene::walk_environment`]).
+///
+/// 1. **Footholds fit their surfaces.** Landings are taken in order of touchdown, each on the
+///    surface under its sole centre (the nearest along the path if none), with three rules, in
+///    order: (i) no surface is skipped: the foot lands on the other foot's surface or the next
+///    one forward along the path; (ii) one foot per short surface ([`SHORT_SURFACE_SOLES`]): not
+///    on the one the other foot stands on, but on the next; (iii) the sole centre is clamped into
+///    its surface's fit interval along the path: where the sole, lengthened by
+///    [`HEEL_MARGIN_M`] behind and [`TOE_MARGIN_M`] ahead, lies over the surface — for a sole
+///    along the path and a surface edge across it, `[start + HEEL_MARGIN_M + L/2, end −
+///    TOE_MARGIN_M − L/2]`; a toed-out sole's corners reach further (its middle if the sole does
+///    not fit). A landing the clamp would take back by more than half its advance on the other
+///    foot goes on to the next surface instead: short steps would otherwise stall at an edge,
+///    each landing short of it.
+///    A landing's shift moves everything after it, as pass 7's do (`shift_landings`), so a
+///    step made longer by rule (ii) can exceed `s_max`.
+/// 2. **Elevation and orientation.** Every contact sole is put on its surface's elevation, and
+///    on a tilted surface made parallel to it (yaw kept; passes 3 and 4 on the real surface).
+///    Each stance's root and free hands rise by its support elevation (the mean elevation of
+///    its feet in contact, interpolated over a stance with none), a held hand's contact run by
+///    that of its first stance (so it does not jump), and a swing foot by the higher of the
+///    surfaces under its lift-off and landing soles ([`swing_reference`]), from which pass 9
+///    measures its height.
+///
+/// Surfaces must tile the walk without one under another, as a scene's do. On the flat ground
+/// the walk was generated on (unbounded planes z = 0) there is nothing to fit and nothing to
+/// lift: the pass returns at once (and on a bounded floor at z = 0 around the walk it changes
+/// nothing either).
+pub fn place_on_terrain(
+    poses: &mut PoseSequence,
+    environment: &Environment,
+    path: &PathFrame,
+    sole: &SoleRectangle,
+) {
+    let flat = |s: &SupportSurface| {
+        s.polygon.is_none()
+            && s.pose.rotation * Vector3::z() == Vector3::z()
+            && s.pose.translation.z == 0.0
+    };
+    if environment.surfaces.iter().all(flat) {
+        return;
+    }
+    shift_landings(
+        poses,
+        path,
+        &mut Footholds {
+            environment,
+            path,
+            sole,
+            surface: [None; 2],
+            along: [None; 2],
+        },
+    );
+    raise_onto_surfaces(poses, environment);
+}
+
+/// A surface's extent along the walking path on one line parallel to the path.
+#[derive(Clone, Copy, Debug)]
+struct Extent {
+    /// Index in the environment's surfaces.
+    surface: usize,
+    from: f64,
+    to: f64,
+}
+
+impl Extent {
+    /// Along-path distance from `along` to the extent (0 inside).
+    fn distance(&self, along: f64) -> f64 {
+        (along - along.clamp(self.from, self.to)).abs()
+    }
+}
+
+/// The landing rule of the terrain pass (rules i–iii of [`place_on_terrain`]).
+struct Footholds<'a> {
+    environment: &'a Environment,
+    path: &'a PathFrame,
+    sole: &'a SoleRectangle,
+    /// Index of the surface each foot last landed on.
+    surface: [Option<usize>; 2],
+    /// Along-path position of each foot's last landing.
+    along: [Option<f64>; 2],
+}
+
+impl Footholds<'_> {
+    /// Extent of surface `k` along the line `lateral` to the left of the path.
+    fn extent(&self, k: usize, lateral: f64) -> Option<Extent> {
+        let from = self.path.point(0.0, lateral);
+        let [start, end] =
+            self.environment.surfaces[k].extent_along(&from, self.path.direction())?;
+        Some(Extent {
+            surface: k,
+            from: start,
+            to: end,
+        })
+    }
+
+    /// Every surface's extent on the line `lateral` to the left of the path.
+    fn extents(&self, lateral: f64) -> impl Iterator<Item = Extent> + '_ {
+        (0..self.environment.surfaces.len()).filter_map(move |k| self.extent(k, lateral))
+    }
+
+    /// The surface a foot landing at `along`, `lateral` lands on, before rules (i)–(iii).
+    fn under(&self, along: f64, lateral: f64) -> Option<Extent> {
+        self.extents(lateral)
+            .min_by(|a, b| a.distance(along).total_cmp(&b.distance(along)))
+    }
+
+    /// The surface after `behind` along the line `lateral`: the first to start after it.
+    fn next(&self, behind: &Extent, lateral: f64) -> Option<Extent> {
+        self.extents(lateral)
+            .filter(|e| e.from > behind.from)
+            .min_by(|a, b| a.from.total_cmp(&b.from))
+    }
+
+    /// The surface foot `f` lands on (rules i and ii).
+    fn choose(&self, f: usize, along: f64, lateral: f64) -> Option<Extent> {
+        let candidate = self.under(along, lateral)?;
+        let Some(other) = self.surface[1 - f].and_then(|k| self.extent(k, lateral)) else {
+            return Some(candidate);
+        };
+        let next = self.next(&other, lateral);
+        let chosen = match next {
+            Some(next) if candidate.from > next.from => next,
+            _ if candidate.from < other.from => other,
+            _ => candidate,
+        };
+        let short = other.to - other.from < SHORT_SURFACE_SOLES * self.sole.length;
+        if chosen.surface == other.surface && short {
+            return Some(next.unwrap_or(other));
+        }
+        Some(chosen)
+    }
+
+    /// Rule (iii): `along` clamped into surface `k`'s fit interval for `sole`: the sole centre
+    /// positions where each corner of the sole lengthened by the margins lies over the surface
+    /// (on the corner's own line parallel to the path; exact for convex surfaces).
+    fn fit(&self, k: usize, along: f64, sole: &Isometry3<f64>) -> f64 {
+        let lateral = self.path.lateral(&sole.translation.vector);
+        let (back, front) = (
+            -self.sole.length / 2.0 - HEEL_MARGIN_M,
+            self.sole.length / 2.0 + TOE_MARGIN_M,
+        );
+        let side = self.sole.width / 2.0;
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        for (x, y) in [(back, side), (back, -side), (front, side), (front, -side)] {
+            let corner = sole.rotation * Vector3::new(x, y, 0.0);
+            let ahead = corner.dot(self.path.direction());
+            let aside = corner.dot(self.path.lateral_axis());
+            if let Some(extent) = self.extent(k, lateral + aside) {
+                lo = lo.max(extent.from - ahead);
+                hi = hi.min(extent.to - ahead);
+            }
+        }
+        if lo <= hi {
+            along.clamp(lo, hi)
+        } else {
+            (lo + hi) / 2.0
+        }
+    }
+}
+
+impl LandingRule for Footholds<'_> {
+    type Placed = Option<usize>;
+
+    fn place(&self, f: usize, along: f64, sole: &Isometry3<f64>) -> (f64, Option<usize>) {
+        let lateral = self.path.lateral(&sole.translation.vector);
+        let Some(extent) = self.choose(f, along, lateral) else {
+            return (0.0, None);
+        };
+        let fitted = self.fit(extent.surface, along, sole);
+        // Clamped back by more than half its advance on the other foot, the walk would stall
+        // at the edge (each landing again short of it): on to the next surface instead.
+        let stalled = self.along[1 - f]
+            .is_some_and(|other| along > other && fitted - other < (along - other) / 2.0);
+        if let Some(next) = self.next(&extent, lateral).filter(|_| stalled) {
+            return (
+                self.fit(next.surface, along, sole) - along,
+                Some(next.surface),
+            );
+        }
+        (fitted - along, Some(extent.surface))
+    }
+
+    fn landed(&mut self, f: usize, along: f64, placed: Option<usize>) {
+        self.surface[f] = placed;
+        self.along[f] = Some(along);
+    }
+}
+
+/// Step 2 of [`place_on_terrain`]: the fitted flat walk lifted onto its surfaces.
+fn raise_onto_surfaces(poses: &mut PoseSequence, environment: &Environment) {
+    let mut previous: Option<(usize, f64)> = None;
+    let mut held = [0.0; 2];
+    for i in 0..poses.len() {
+        let support = support_elevation(poses, environment, i);
+        let elevation = support.unwrap_or_else(|| {
+            let next = (i + 1..poses.len())
+                .find_map(|j| support_elevation(poses, environment, j).map(|e| (j, e)));
+            match (previous, next) {
+                (Some((a, ea)), Some((b, eb))) => ea + (eb - ea) * (i - a) as f64 / (b - a) as f64,
+                (Some((_, e)), None) | (None, Some((_, e))) => e,
+                (None, None) => 0.0,
+            }
+        });
+        if support.is_some() {
+            previous = Some((i, elevation));
+        }
+        let swing_lift = FEET.map(|foot| {
+            if poses.in_contact(i, foot) {
+                0.0
+            } else {
+                swing_reference(poses, environment, i, foot).unwrap_or(elevation)
+            }
+        });
+        poses.roots[i].translation.vector.z += elevation;
+        for (f, foot) in FEET.into_iter().enumerate() {
+            if poses.in_contact(i, foot) {
+                lay(poses, i, foot, environment);
+            } else {
+                poses.end_effectors[i][foot as usize].translation.vector.z += swing_lift[f];
+            }
+        }
+        for (h, hand) in HANDS.into_iter().enumerate() {
+            if poses.contact_starts(i, hand) {
+                held[h] = elevation;
+            }
+            let lift = if poses.in_contact(i, hand) {
+                held[h]
+            } else {
+                elevation
+            };
+            poses.end_effectors[i][hand as usize].translation.vector.z += lift;
+        }
+    }
+}
+
+/// Mean elevation of the surfaces under the feet in contact in stance `i` (a foot over none
+/// counts with its own height); `None` without a foot in contact.
+fn support_elevation(poses: &PoseSequence, environment: &Environment, i: usize) -> Option<f64> {
+    let (sum, count) = FEET
+        .iter()
+        .filter(|&&foot| poses.in_contact(i, foot))
+        .map(|&foot| {
+            let p = poses.pose(i, foot).translation.vector;
+            environment.support_at(&p).map_or(p.z, |(_, z)| z)
+        })
+        .fold((0.0, 0), |(sum, n), z| (sum + z, n + 1));
+    (count > 0).then(|| sum / count as f64)
+}
+
+/// Puts foot `foot`'s contact sole of stance `i` on the surface under it: on its elevation
+/// and, on a tilted surface, parallel to it with its yaw kept (on a horizontal one it keeps its
+/// rotation, which pass 3 made level). A sole over no surface is left as is.
+fn lay(poses: &mut PoseSequence, i: usize, foot: EndEffector, environment: &Environment) {
+    let pose = poses.pose(i, foot);
+    let Some((surface, z)) = environment.support_at(&pose.translation.vector) else {
+        return;
+    };
+    let rotation = if surface.pose.rotation * Vector3::z() == Vector3::z() {
+        None
+    } else {
+        flattened(&surface.pose.rotation, &pose.rotation)
+    };
+    let target = &mut poses.end_effectors[i][foot as usize];
+    target.translation.vector.z = z;
+    if let Some(rotation) = rotation {
+        target.rotation = rotation;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::roll_pitch_yaw;
+    use crate::passes::fixtures::{BOTH, LEFT, RIGHT, SOLE, block, rotated, stance, walk, x_path};
+    use kinematics::robot::EndEffector::{LeftFoot, LeftHand, RightFoot, RightHand};
+    use nalgebra::UnitQuaternion;
+
+    /// A floor to x = 0.5, three 0.3 m treads rising 0.1 m each, a landing from x = 1.4.
+    fn stairs() -> Environment {
+        Environment {
+            surfaces: vec![
+                block("floor", -1.0, 0.5, 0.0),
+                block("tread-1", 0.5, 0.8, 0.1),
+                block("tread-2", 0.8, 1.1, 0.2),
+                block("tread-3", 1.1, 1.4, 0.3),
+                block("landing", 1.4, 3.0, 0.4),
+            ],
+            hand_affordances: Vec::new(),
+        }
+    }
+
+    /// A flat walk: both feet at x = 0, then the `landings` in turn, right foot first; before
+    /// each a single support with the swing foot half-way and 0.05 m up, after it a double
+    /// support.
+    fn flat_walk(landings: &[f64]) -> PoseSequence {
+        let mut feet = [0.0, 0.0];
+        let mut stances = vec![stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH)];
+        for (k, &x) in landings.iter().enumerate() {
+            let swing = 1 - k % 2;
+            let mut at = feet.map(|x| [x, 0.0]);
+            at[swing] = [(feet[swing] + x) / 2.0, 0.05];
+            let contacts = if swing == 1 { LEFT } else { RIGHT };
+            stances.push(stance(
+                [at[0][0], 0.1, at[0][1]],
+                [at[1][0], -0.1, at[1][1]],
+                contacts,
+            ));
+            feet[swing] = x;
+            stances.push(stance([feet[0], 0.1, 0.0], [feet[1], -0.1, 0.0], BOTH));
+        }
+        walk(&stances)
+    }
+
+    /// Along-path position and elevation of each contact run's foot, in touchdown order.
+    fn footholds(poses: &PoseSequence) -> Vec<[f64; 2]> {
+        (0..poses.len())
+            .flat_map(|i| FEET.map(|foot| (i, foot)))
+            .filter(|&(i, foot)| poses.contact_starts(i, foot))
+            .map(|(i, foot)| {
+                let p = poses.pose(i, foot).translation.vector;
+                [p.x, p.z]
+            })
+            .collect()
+    }
+
+    fn assert_footholds(poses: &PoseSequence, expected: &[[f64; 2]]) {
+        let found = footholds(poses);
+        assert_eq!(found.len(), expected.len(), "{found:?}");
+        for (f, e) in found.iter().zip(expected) {
+            assert!(
+                (f[0] - e[0]).abs() < 1e-12 && (f[1] - e[1]).abs() < 1e-12,
+                "{found:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn on_the_flat_ground_nothing_changes() {
+        let mut p = flat_walk(&[0.3, 0.6, 0.9, 1.2]);
+        rotated(&mut p, 3, LeftFoot, [0.0, 0.0, 0.2]);
+        rotated(&mut p, 4, LeftFoot, [0.0, 0.0, 0.2]);
+        p.contacts[2][RightHand as usize] = true;
+        let before = p.clone();
+        place_on_terrain(&mut p, &Environment::default(), &x_path(), &SOLE);
+        assert_eq!(p, before);
+        // Not by the early return alone: a floor at z = 0 with room around the walk.
+        let floor = Environment {
+            surfaces: vec![block("floor", -1.0, 3.0, 0.0)],
+            hand_affordances: Vec::new(),
+        };
+        place_on_terrain(&mut p, &floor, &x_path(), &SOLE);
+        assert_eq!(p, before);
+    }
+
+    #[test]
+    fn stairs_take_one_foot_per_tread_with_the_toes_clear_of_the_risers() {
+        let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
+        place_on_terrain(&mut p, &stairs(), &x_path(), &SOLE);
+        // Floor: its fit interval ends 0.03 + 0.1 before the riser at 0.5 (0.4 → 0.37). Each
+        // tread's interval is [from + 0.12, to − 0.13]: a landing on the tread the other foot
+        // stands on goes on to the next one, to the interval's start.
+        assert_footholds(
+            &p,
+            &[
+                [0.0, 0.0],
+                [0.0, 0.0],
+                [0.2, 0.0],
+                [0.37, 0.0],
+                [0.62, 0.1],
+                [0.92, 0.2],
+                [1.22, 0.3],
+                [1.52, 0.4],
+                [1.67, 0.4],
+            ],
+        );
+        // The left foot swings from the floor (0.37) to tread-2 (0.92) in stance 7: half-way,
+        // 0.05 m above tread-2. The root of the double support that follows rises by the mean
+        // of tread-1 and tread-2.
+        let swing = p.pose(7, LeftFoot).translation.vector;
+        assert!(
+            (swing.x - 0.645).abs() < 1e-12 && (swing.z - 0.25).abs() < 1e-12,
+            "{swing:?}"
+        );
+        let root = p.roots[8].translation.vector;
+        assert!((root.z - (0.8 + 0.15)).abs() < 1e-12, "{root:?}");
+    }
+
+    #[test]
+    fn short_steps_do_not_stall_at_an_edge() {
+        let mut p = flat_walk(&[0.12, 0.24, 0.36, 0.48, 0.6, 0.72, 0.84, 0.96]);
+        place_on_terrain(&mut p, &stairs(), &x_path(), &SOLE);
+        // 0.48 is clamped back to the floor's 0.37, 1 cm of its 12 cm advance on the right foot
+        // (0.36): tread-1 instead, then one foot per tread.
+        assert_footholds(
+            &p,
+            &[
+                [0.0, 0.0],
+                [0.0, 0.0],
+                [0.12, 0.0],
+                [0.24, 0.0],
+                [0.36, 0.0],
+                [0.62, 0.1],
+                [0.92, 0.2],
+                [1.22, 0.3],
+                [1.52, 0.4],
+                [1.64, 0.4],
+            ],
+        );
+    }
+
+    #[test]
+    fn a_long_step_does_not_skip_a_tread() {
+        let mut p = flat_walk(&[0.2, 0.3, 1.0]);
+        place_on_terrain(&mut p, &stairs(), &x_path(), &SOLE);
+        // The right foot would land on tread-2 while the left stands on the floor: tread-1, as
+        // far forward as it fits.
+        let right = p.pose(p.len() - 1, RightFoot).translation.vector;
+        assert!(
+            (right.x - 0.67).abs() < 1e-12 && (right.z - 0.1).abs() < 1e-12,
+            "{right:?}"
+        );
+    }
+
+    #[test]
+    fn hands_rise_with_the_support_and_a_held_hand_as_a_whole() {
+        let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7]);
+        for contacts in &mut p.contacts[4..=6] {
+            contacts[RightHand as usize] = true;
+        }
+        let before = p.clone();
+        place_on_terrain(&mut p, &stairs(), &x_path(), &SOLE);
+        let rise =
+            |i: usize, e: EndEffector| p.pose(i, e).translation.z - before.pose(i, e).translation.z;
+        // Stance 4: both feet on the floor; 6: the left foot on tread-1 (0.1), the right on the
+        // floor... then on tread-2: the held right hand keeps the rise of its first stance.
+        for i in 4..=6 {
+            assert!(
+                rise(i, RightHand).abs() < 1e-12,
+                "stance {i}: {}",
+                rise(i, RightHand)
+            );
+        }
+        let support = (0.1 + 0.0) / 2.0;
+        assert!(
+            (rise(6, LeftHand) - support).abs() < 1e-12,
+            "{}",
+            rise(6, LeftHand)
+        );
+        assert!(
+            (rise(8, LeftHand) - 0.15).abs() < 1e-12,
+            "{}",
+            rise(8, LeftHand)
+        );
+    }
+
+    #[test]
+    fn a_sole_on_a_ramp_lies_on_its_plane_pitched_with_it() {
+        let slope = 10f64.to_radians();
+        let ramp = SupportSurface {
+            name: "ramp".into(),
+            pose: Isometry3::from_parts(
+                Vector3::zeros().into(),
+                UnitQuaternion::from_euler_angles(0.0, -slope, 0.0),
+            ),
+            polygon: Some(vec![[-1.0, -0.5], [1.0, -0.5], [1.0, 0.5], [-1.0, 0.5]]),
+        };
+        let env = Environment {
+            surfaces: vec![ramp],
+            hand_affordances: Vec::new(),
+        };
+        let mut p = walk(&[stance([0.3, 0.1, 0.0], [0.3, -0.1, 0.0], BOTH)]);
+        rotated(&mut p, 0, LeftFoot, [0.0, 0.0, 0.1]);
+        place_on_terrain(&mut p, &env, &x_path(), &SOLE);
+        let left = p.pose(0, LeftFoot);
+        assert!((left.translation.z - 0.3 * slope.tan()).abs() < 1e-12);
+        let normal = env.surfaces[0].pose.rotation * Vector3::z();
+        assert!(
+            (left.rotation * Vector3::z() - normal).norm() < 1e-12,
+            "parallel"
+        );
+        let x = left.rotation * Vector3::x();
+        // Its x is the toed-out x projected onto the ramp along the normal.
+        let heading = 0.1f64.sin().atan2(0.1f64.cos() * slope.cos().powi(2));
+        assert!((x.y.atan2(x.x) - heading).abs() < 1e-12, "toe-out kept");
+        let [roll, pitch, yaw] = roll_pitch_yaw(&p.pose(0, RightFoot).rotation);
+        assert!(roll.abs() < 1e-12 && yaw.abs() < 1e-12 && (pitch + slope).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_stance_without_a_foot_in_contact_rises_by_the_interpolated_support() {
+        let mut p = walk(&[
+            stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH),
+            stance([0.3, 0.1, 0.05], [0.3, -0.1, 0.05], [false; 4]),
+            stance([0.6, 0.1, 0.0], [0.6, -0.1, 0.0], BOTH),
+        ]);
+        let before = p.clone();
+        place_on_terrain(&mut p, &stairs(), &x_path(), &SOLE);
+        let rise = |i: usize| p.roots[i].translation.z - before.roots[i].translation.z;
+        assert!(rise(0).abs() < 1e-12 && (rise(2) - 0.1).abs() < 1e-12);
+        assert!((rise(1) - 0.05).abs() < 1e-12, "{}", rise(1));
+    }
+}
