@@ -407,3 +407,21 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_scene_is_refused_without_mujoco_and_loaded_with_it() {
+        let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/scenes/ramp-10deg.toml");
+        let error = load_scene(Some(&scene), Physics::Kinematic).unwrap_err();
+        assert!(
+            error.to_string().contains("--scene needs --physics mujoco"),
+            "{error}"
+        );
+        let loaded = load_scene(Some(&scene), Physics::Mujoco).unwrap().unwrap();
+        assert_eq!(loaded.name, "ramp-10deg");
+        assert!(load_scene(None, Physics::Kinematic).unwrap().is_none());
+    }
+}

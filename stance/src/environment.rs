@@ -163,6 +163,16 @@ impl Default for Environment {
 }
 
 impl Environment {
+    /// Whether every surface is an unbounded horizontal plane at z = 0: the flat ground a stance
+    /// source generates on, where the terrain pass has nothing to do.
+    pub fn is_flat_ground(&self) -> bool {
+        self.surfaces.iter().all(|s| {
+            s.polygon.is_none()
+                && s.pose.rotation * Vector3::z() == Vector3::z()
+                && s.pose.translation.z == 0.0
+        })
+    }
+
     /// The surface a point belongs to and its elevation there: of the surfaces under or above the
     /// point, the one vertically nearest. `None` if no surface covers the point's `(x, y)`.
     pub fn support_at(&self, point: &Vector3<f64>) -> Option<(&SupportSurface, f64)> {

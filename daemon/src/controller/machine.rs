@@ -618,8 +618,9 @@ pub(crate) fn heading_frame(pose: &Isometry3<f64>) -> Isometry3<f64> {
 
 /// `pose` moved up by `height` along world z.
 /// A height difference between where a foot lifts off and where it lands counts as a step up
-/// or down (a stair or a ramp) above this (m); below it the swing is the flat-ground one.
-const STEP_HEIGHT_M: f64 = 0.01;
+/// or down (a stair or a ramp) above this (m); below it the swing is the flat-ground one. Both
+/// gaits shape their swings by it.
+pub(crate) const STEP_HEIGHT_M: f64 = 0.01;
 
 /// The extra height of a swing that climbs (or descends) `height` (m): all of it for a step,
 /// none on flat ground.

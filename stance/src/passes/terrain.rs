@@ -6,13 +6,15 @@
 //! surfaces they land on: this pass, right after pass 8 and before pass 9 (which then measures
 //! swing heights on the real surfaces).
 
+use kinematics::ground::planar_frame;
 use kinematics::robot::{EndEffector, SoleRectangle};
 use nalgebra::{Isometry3, Vector3};
 
 use super::orientation::flattened;
 use super::path::{LandingRule, shift_landings};
+use super::path_of;
 use crate::derived::swing_reference;
-use crate::environment::{Environment, SupportSurface};
+use crate::environment::Environment;
 use crate::geometry::PathFrame;
 use crate::poses::{FEET, HANDS, PoseSequence};
 
@@ -33,6 +35,12 @@ pub const SHORT_SURFACE_SOLES: f64 = 2.0;
 /// plane z = 0 through the start (the environment is expressed in the walk's frame, start at
 /// the origin: [`crate::Scene::walk_environment`]).
 ///
+/// 0. **The walk starts where the scene starts.** The whole walk is moved (x, y, yaw) so its
+///    first stance's feet in contact have their mean at the origin, heading +x: the controller
+///    aligns a sequence by putting those feet onto the robot's standing feet, and the robot
+///    stands at the scene's start. The flat walk's first feet are a few centimetres off the
+///    origin (about 5 cm behind it on JVRC-1), and a foothold fitted to a tread that many
+///    centimetres from where the robot puts it lands on the riser.
 /// 1. **Footholds fit their surfaces.** Landings are taken in order of touchdown, each on the
 ///    surface under its sole centre (the nearest along the path if none), with three rules, in
 ///    order: (i) no surface is skipped: the foot lands on the other foot's surface or the next
@@ -59,20 +67,12 @@ pub const SHORT_SURFACE_SOLES: f64 = 2.0;
 /// the walk was generated on (unbounded planes z = 0) there is nothing to fit and nothing to
 /// lift: the pass returns at once (and on a bounded floor at z = 0 around the walk it changes
 /// nothing either).
-pub fn place_on_terrain(
-    poses: &mut PoseSequence,
-    environment: &Environment,
-    path: &PathFrame,
-    sole: &SoleRectangle,
-) {
-    let flat = |s: &SupportSurface| {
-        s.polygon.is_none()
-            && s.pose.rotation * Vector3::z() == Vector3::z()
-            && s.pose.translation.z == 0.0
-    };
-    if environment.surfaces.iter().all(flat) {
+pub fn place_on_terrain(poses: &mut PoseSequence, environment: &Environment, sole: &SoleRectangle) {
+    if environment.is_flat_ground() {
         return;
     }
+    start_at_the_origin(poses);
+    let path = &path_of(poses).expect("a walk on terrain has stances");
     shift_landings(
         poses,
         path,
@@ -85,6 +85,24 @@ pub fn place_on_terrain(
         },
     );
     raise_onto_surfaces(poses, environment);
+}
+
+/// Moves every pose of the walk by the same planar transform, so the first stance's feet in
+/// contact have their mean at the origin, heading +x.
+fn start_at_the_origin(poses: &mut PoseSequence) {
+    let first = FEET
+        .iter()
+        .filter(|&&foot| poses.in_contact(0, foot))
+        .map(|&foot| poses.pose(0, foot));
+    let to_start = planar_frame(first).inverse();
+    for root in &mut poses.roots {
+        *root = to_start * *root;
+    }
+    for stance in &mut poses.end_effectors {
+        for pose in stance {
+            *pose = to_start * *pose;
+        }
+    }
 }
 
 /// A surface's extent along the walking path on one line parallel to the path.
@@ -304,8 +322,9 @@ fn lay(poses: &mut PoseSequence, i: usize, foot: EndEffector, environment: &Envi
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::environment::SupportSurface;
     use crate::geometry::roll_pitch_yaw;
-    use crate::passes::fixtures::{BOTH, LEFT, RIGHT, SOLE, block, rotated, stance, walk, x_path};
+    use crate::passes::fixtures::{BOTH, LEFT, RIGHT, SOLE, block, rotated, stance, walk};
     use kinematics::robot::EndEffector::{LeftFoot, LeftHand, RightFoot, RightHand};
     use nalgebra::UnitQuaternion;
 
@@ -375,21 +394,21 @@ mod tests {
         rotated(&mut p, 4, LeftFoot, [0.0, 0.0, 0.2]);
         p.contacts[2][RightHand as usize] = true;
         let before = p.clone();
-        place_on_terrain(&mut p, &Environment::default(), &x_path(), &SOLE);
+        place_on_terrain(&mut p, &Environment::default(), &SOLE);
         assert_eq!(p, before);
         // Not by the early return alone: a floor at z = 0 with room around the walk.
         let floor = Environment {
             surfaces: vec![block("floor", -1.0, 3.0, 0.0)],
             hand_affordances: Vec::new(),
         };
-        place_on_terrain(&mut p, &floor, &x_path(), &SOLE);
+        place_on_terrain(&mut p, &floor, &SOLE);
         assert_eq!(p, before);
     }
 
     #[test]
     fn stairs_take_one_foot_per_tread_with_the_toes_clear_of_the_risers() {
         let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
-        place_on_terrain(&mut p, &stairs(), &x_path(), &SOLE);
+        place_on_terrain(&mut p, &stairs(), &SOLE);
         // Floor: its fit interval ends 0.03 + 0.1 before the riser at 0.5 (0.4 → 0.37). Each
         // tread's interval is [from + 0.12, to − 0.13]: a landing on the tread the other foot
         // stands on goes on to the next one, to the interval's start.
@@ -422,7 +441,7 @@ mod tests {
     #[test]
     fn short_steps_do_not_stall_at_an_edge() {
         let mut p = flat_walk(&[0.12, 0.24, 0.36, 0.48, 0.6, 0.72, 0.84, 0.96]);
-        place_on_terrain(&mut p, &stairs(), &x_path(), &SOLE);
+        place_on_terrain(&mut p, &stairs(), &SOLE);
         // 0.48 is clamped back to the floor's 0.37, 1 cm of its 12 cm advance on the right foot
         // (0.36): tread-1 instead, then one foot per tread.
         assert_footholds(
@@ -445,7 +464,7 @@ mod tests {
     #[test]
     fn a_long_step_does_not_skip_a_tread() {
         let mut p = flat_walk(&[0.2, 0.3, 1.0]);
-        place_on_terrain(&mut p, &stairs(), &x_path(), &SOLE);
+        place_on_terrain(&mut p, &stairs(), &SOLE);
         // The right foot would land on tread-2 while the left stands on the floor: tread-1, as
         // far forward as it fits.
         let right = p.pose(p.len() - 1, RightFoot).translation.vector;
@@ -462,7 +481,7 @@ mod tests {
             contacts[RightHand as usize] = true;
         }
         let before = p.clone();
-        place_on_terrain(&mut p, &stairs(), &x_path(), &SOLE);
+        place_on_terrain(&mut p, &stairs(), &SOLE);
         let rise =
             |i: usize, e: EndEffector| p.pose(i, e).translation.z - before.pose(i, e).translation.z;
         // Stance 4: both feet on the floor; 6: the left foot on tread-1 (0.1), the right on the
@@ -488,6 +507,20 @@ mod tests {
     }
 
     #[test]
+    fn the_walk_is_moved_so_its_first_feet_stand_at_the_scene_start() {
+        let mut p = walk(&[
+            stance([-0.05, 0.1, 0.0], [-0.05, -0.1, 0.0], BOTH),
+            stance([-0.05, 0.1, 0.0], [0.2, -0.1, 0.0], BOTH),
+        ]);
+        place_on_terrain(&mut p, &stairs(), &SOLE);
+        let (left, right) = (p.pose(0, LeftFoot), p.pose(0, RightFoot));
+        let middle = (left.translation.vector + right.translation.vector) / 2.0;
+        assert!(middle.xy().norm() < 1e-12, "{middle}");
+        // The rest of the walk moved with it.
+        assert!((p.pose(1, RightFoot).translation.x - 0.25).abs() < 1e-12);
+    }
+
+    #[test]
     fn a_sole_on_a_ramp_lies_on_its_plane_pitched_with_it() {
         let slope = 10f64.to_radians();
         let ramp = SupportSurface {
@@ -502,10 +535,13 @@ mod tests {
             surfaces: vec![ramp],
             hand_affordances: Vec::new(),
         };
-        let mut p = walk(&[stance([0.3, 0.1, 0.0], [0.3, -0.1, 0.0], BOTH)]);
-        rotated(&mut p, 0, LeftFoot, [0.0, 0.0, 0.1]);
-        place_on_terrain(&mut p, &env, &x_path(), &SOLE);
-        let left = p.pose(0, LeftFoot);
+        let mut p = walk(&[
+            stance([0.0, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH),
+            stance([0.3, 0.1, 0.0], [0.3, -0.1, 0.0], BOTH),
+        ]);
+        rotated(&mut p, 1, LeftFoot, [0.0, 0.0, 0.1]);
+        place_on_terrain(&mut p, &env, &SOLE);
+        let left = p.pose(1, LeftFoot);
         assert!((left.translation.z - 0.3 * slope.tan()).abs() < 1e-12);
         let normal = env.surfaces[0].pose.rotation * Vector3::z();
         assert!(
@@ -528,7 +564,7 @@ mod tests {
             stance([0.6, 0.1, 0.0], [0.6, -0.1, 0.0], BOTH),
         ]);
         let before = p.clone();
-        place_on_terrain(&mut p, &stairs(), &x_path(), &SOLE);
+        place_on_terrain(&mut p, &stairs(), &SOLE);
         let rise = |i: usize| p.roots[i].translation.z - before.roots[i].translation.z;
         assert!(rise(0).abs() < 1e-12 && (rise(2) - 0.1).abs() < 1e-12);
         assert!((rise(1) - 0.05).abs() < 1e-12, "{}", rise(1));

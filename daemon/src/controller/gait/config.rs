@@ -34,6 +34,11 @@ pub struct GaitConfig {
 pub struct DynamicGaitConfig {
     /// Duration of a single-support phase: lift-off to planned touchdown (s).
     pub single_support_s: f64,
+    /// Duration of the single support of a step up or down (landing more than
+    /// [`STEP_HEIGHT_M`](crate::controller::machine::STEP_HEIGHT_M) above or below the lift-off:
+    /// a stair, a ramp), where the foot travels farther and moves horizontally over part of the
+    /// swing only (s); absent: [`STEP_SINGLE_SUPPORT_FACTOR`] × `single_support_s`.
+    pub step_single_support_s: Option<f64>,
     /// Duration of a double-support phase between two steps: the ZMP crosses to the next
     /// stance foot (s).
     pub double_support_s: f64,
@@ -87,12 +92,17 @@ pub struct DynamicGaitConfig {
     pub stabilizer: StabilizerConfig,
 }
 
+/// A step up or down's single support, relative to a flat step's, unless configured: one foot
+/// per 0.30 m stair travels 0.60 m, and its horizontal motion has three quarters of the swing.
+pub const STEP_SINGLE_SUPPORT_FACTOR: f64 = 1.5;
+
 /// The tuning that walks JVRC-1 under MuJoCo (configs/jvrc1.toml, 0.26 m/s), so an empty
 /// `[gait.dynamic]` walks an HRP-class robot; `walkctl init-robot` derives a robot's own.
 impl Default for DynamicGaitConfig {
     fn default() -> Self {
         Self {
             single_support_s: 0.55,
+            step_single_support_s: None,
             double_support_s: 0.25,
             initial_double_support_s: 1.0,
             final_double_support_s: 1.0,
@@ -302,6 +312,12 @@ fn deserialize<T: serde::de::DeserializeOwned>(
 }
 
 impl DynamicGaitConfig {
+    /// The single support of a step up or down (`step_single_support_s` or its default).
+    pub fn step_single_support(&self) -> f64 {
+        self.step_single_support_s
+            .unwrap_or(STEP_SINGLE_SUPPORT_FACTOR * self.single_support_s)
+    }
+
     /// Checks every value against its documented range (docs/controller.md, "Dynamic gait");
     /// `origin` names the file in the error.
     pub fn validate(&self, origin: &str) -> Result<(), ConfigError> {
@@ -323,6 +339,12 @@ impl DynamicGaitConfig {
     pub fn bounds(&self) -> Vec<Bound> {
         vec![
             Bound::new("single_support_s", self.single_support_s, 0.1, 5.0),
+            Bound::optional(
+                "step_single_support_s",
+                self.step_single_support_s,
+                0.1,
+                5.0,
+            ),
             Bound::new("double_support_s", self.double_support_s, 0.01, 5.0),
             Bound::new(
                 "initial_double_support_s",
@@ -492,6 +514,7 @@ mod tests {
     fn durations_and_gains_have_upper_bounds() {
         for (table, key) in [
             ("gait.dynamic", "single_support_s"),
+            ("gait.dynamic", "step_single_support_s"),
             ("gait.dynamic", "double_support_s"),
             ("gait.dynamic", "initial_double_support_s"),
             ("gait.dynamic", "final_double_support_s"),

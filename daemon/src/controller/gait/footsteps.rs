@@ -22,6 +22,7 @@ use kinematics::robot::EndEffector;
 use nalgebra::Isometry3;
 
 use super::config::DynamicGaitConfig;
+use crate::controller::machine::STEP_HEIGHT_M;
 use crate::controller::sequence::{PreparedStance, Refusal};
 
 /// The feet, in the order of the `[_; 2]` arrays of this module (left, right).
@@ -93,8 +94,8 @@ struct Builder<'a> {
     clock: f64,
     /// Planned poses of the feet on the ground.
     feet: [Option<Isometry3<f64>>; 2],
-    /// The swing under way: its foot and the highest swing pose so far.
-    swing: Option<(EndEffector, Isometry3<f64>)>,
+    /// The swing under way: its foot, the highest swing pose so far and its lift-off height.
+    swing: Option<(EndEffector, Isometry3<f64>, f64)>,
     stepped: bool,
 }
 
@@ -212,7 +213,7 @@ impl Builder<'_> {
         let in_contact = FEET.map(|f| stance.contacts[f as usize]);
         let added = [0, 1].map(|f| in_contact[f] && self.feet[f].is_none());
         let released = [0, 1].map(|f| !in_contact[f] && self.feet[f].is_some());
-        if let Some((foot, apex)) = &mut self.swing {
+        if let Some((foot, apex, _)) = &mut self.swing {
             let candidate = stance.targets[*foot as usize];
             if !in_contact[slot(*foot)] && candidate.translation.z > apex.translation.z {
                 *apex = candidate;
@@ -231,8 +232,9 @@ impl Builder<'_> {
                     self.timing.initial_double_support_s
                 };
                 self.double_support(duration, Some(FEET[f]));
+                let lift_off_z = self.feet[f].map_or(0.0, |foot| foot.translation.z);
                 self.feet[f] = None;
-                self.swing = Some((FEET[f], stance.targets[FEET[f] as usize]));
+                self.swing = Some((FEET[f], stance.targets[FEET[f] as usize], lift_off_z));
             }
         }
         let feet_change = added.iter().chain(&released).any(|c| *c);
@@ -243,18 +245,23 @@ impl Builder<'_> {
 
     /// The single support in which the swing under way lands `foot` at `landing`.
     fn touchdown(&mut self, foot: EndEffector, landing: Isometry3<f64>) {
-        let (swinging, apex) = self
+        let (swinging, apex, lift_off_z) = self
             .swing
             .take()
             .expect("a foot is added only while it is in the air");
         debug_assert_eq!(swinging, foot);
+        let duration = if (landing.translation.z - lift_off_z).abs() > STEP_HEIGHT_M {
+            self.timing.step_single_support()
+        } else {
+            self.timing.single_support_s
+        };
         self.push(
             Support::Single(SwingPlan {
                 foot,
                 apex,
                 landing,
             }),
-            self.timing.single_support_s,
+            duration,
         );
         self.feet[slot(foot)] = Some(landing);
         self.stepped = true;
@@ -326,6 +333,32 @@ mod tests {
                 Support::Single(_) => "ss",
             })
             .collect()
+    }
+
+    #[test]
+    fn a_step_up_takes_the_step_single_support() {
+        let timing = DynamicGaitConfig::default();
+        let stances = [
+            stance(DS, standing()[0], standing()[1]),
+            stance(LEFT_UP, at(0.15, 0.1, 0.13), standing()[1]),
+            stance(DS, at(0.3, 0.1, 0.1), standing()[1]),
+            stance(RIGHT_UP, at(0.3, 0.1, 0.1), at(0.15, -0.1, 0.04)),
+            stance(DS, at(0.3, 0.1, 0.1), at(0.3, -0.1, 0.005)),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        let singles: Vec<f64> = plan
+            .phases
+            .iter()
+            .filter(|p| matches!(p.support, Support::Single(_)))
+            .map(|p| p.duration_s)
+            .collect();
+        // The left foot up 0.10 m: a step; the right up 0.005 m: a flat step (its swing pose's
+        // height does not count).
+        assert_eq!(
+            singles,
+            [timing.step_single_support(), timing.single_support_s]
+        );
+        assert!(timing.step_single_support() > timing.single_support_s);
     }
 
     #[test]

@@ -15,10 +15,8 @@
 
 use nalgebra::{Isometry3, Translation3, Vector2};
 
+use crate::controller::machine::STEP_HEIGHT_M;
 use crate::controller::trajectory::{PointTrajectory, PoseTrajectory, Profile};
-
-/// A height difference between lift-off and landing above which a swing is a step up or down.
-pub(crate) const STEP_HEIGHT_M: f64 = 0.01;
 
 /// The share of a step up's (down's) swing before (after) its horizontal motion.
 pub(crate) const EDGE_CLEARING_SHARE: f64 = 0.25;
