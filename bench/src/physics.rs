@@ -28,7 +28,7 @@ use daemon::controller::{
 use kinematics::ConfigFile;
 use kinematics::ground::GRAVITY;
 use kinematics::robot::{EndEffector, Robot};
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{Isometry3, Vector2, Vector3};
 use sim_adapter::MotorLoad;
 use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim, Terrain};
 use stance::poses::FEET;
@@ -337,6 +337,10 @@ pub fn walk_sequence(
         trace: Vec::with_capacity((max_ticks / options.trace_every.max(1)).min(1 << 20) as usize),
         max_com_drift: 0.0,
         max_foot_drift: 0.0,
+        controller_frame: options
+            .scene
+            .as_ref()
+            .map_or_else(Isometry3::identity, |scene| scene.start),
         max_tilt: 0.0,
         controller_time: Duration::ZERO,
         physics_time: Duration::ZERO,
@@ -365,7 +369,7 @@ pub fn walk_sequence(
                 t: sim.time(),
                 stance_index: status.stance_index,
                 target: targets[(status.stance_index as usize).min(targets.len() - 1)],
-                controller: controller_points(status),
+                controller: controller_points(status).transformed(&loop_state.controller_frame),
                 sim: Some(sim_points(sim)),
             };
             loop_state.trace.push(sample);
@@ -560,6 +564,8 @@ struct LoopState {
     trace: Vec<TraceSample>,
     max_com_drift: f64,
     max_foot_drift: f64,
+    /// Where the controller's world frame lies in the simulator's (a scene's start).
+    controller_frame: Isometry3<f64>,
     max_tilt: f64,
     controller_time: Duration,
     physics_time: Duration,
@@ -603,7 +609,9 @@ impl LoopState {
         if !feet_down && self.first_step_s.is_none() {
             self.first_step_s = Some(sim.time());
         }
-        self.balance.observe(status, sim.measurement().com, dt);
+        // The balance readings are in the controller's frame; the simulator's CoM is mapped there.
+        let com = self.controller_frame.inverse() * nalgebra::Point3::from(sim.measurement().com);
+        self.balance.observe(status, com.coords, dt);
         if let Some(push) = &mut self.push {
             sim.set_pelvis_force(push.force(status.phase, sim.time()));
         }
@@ -611,7 +619,8 @@ impl LoopState {
 
     /// Drift and fall indicators of the state after a tick.
     fn observe(&mut self, sim: &MujocoSim, status: &ControllerStatus) {
-        let (com, feet) = sim_points(sim).distances(&controller_points(status));
+        let controller = controller_points(status).transformed(&self.controller_frame);
+        let (com, feet) = sim_points(sim).distances(&controller);
         self.max_com_drift = self.max_com_drift.max(com);
         self.max_foot_drift = self.max_foot_drift.max(feet);
         self.max_tilt = self.max_tilt.max(sim.torso_tilt());

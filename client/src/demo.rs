@@ -315,6 +315,9 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
                 progress.update(status);
             }
         },
+        controller_frame: scene
+            .as_ref()
+            .map_or_else(nalgebra::Isometry3::identity, |scene| scene.start),
     };
     let walk = watch_walk(&client, &prefix, &robot, &sequence, &options)?;
     if let Some(progress) = &progress {

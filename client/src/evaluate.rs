@@ -133,6 +133,16 @@ impl Points {
         }
     }
 
+    /// The points moved by `to`.
+    pub fn transformed(&self, to: &Isometry3<f64>) -> Self {
+        let map = |p: &Vector3<f64>| (to * Point3::from(*p)).coords;
+        Self {
+            com: map(&self.com),
+            left_foot: map(&self.left_foot),
+            right_foot: map(&self.right_foot),
+        }
+    }
+
     /// Distances between corresponding points: (CoM, larger of the two soles).
     pub fn distances(&self, other: &Points) -> (f64, f64) {
         let com = (self.com - other.com).norm();
@@ -490,6 +500,7 @@ fn run_once(
         linger: Duration::from_secs(u64::from(injection.is_some())),
         timeout: Duration::from_secs(120 + 60 * sequence.len() as u64),
         on_status: &|_| {},
+        controller_frame: scene.map_or_else(Isometry3::identity, |scene| scene.start),
     };
     let walk = watch_walk(&client, &prefix, model, &sequence, &options)?;
     drop(client);

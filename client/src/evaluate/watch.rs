@@ -30,6 +30,11 @@ pub(crate) struct WatchOptions<'a> {
     pub timeout: Duration,
     /// Called with every status while the walk runs (e.g. a progress line).
     pub on_status: &'a dyn Fn(&DaemonStatus),
+    /// Where the controller's world frame lies in the simulator's: the controller sets it up
+    /// on the feet it stands on, the simulator puts the robot at a scene's start (identity on
+    /// the flat floor). The trace's controller points are mapped by it, so the drift compares
+    /// like with like.
+    pub controller_frame: Isometry3<f64>,
 }
 
 /// What watching one walk recorded.
@@ -95,7 +100,9 @@ pub(crate) fn watch_walk(
     let last = client.wait_for_sequence(id, options.timeout, |status| {
         (options.on_status)(status);
         if status.sequence_id == id {
-            trace.push(sample(status, &start, &targets));
+            let mut sample = sample(status, &start, &targets);
+            sample.controller = sample.controller.transformed(&options.controller_frame);
+            trace.push(sample);
             status_times.push(status.timestamp_ns);
         }
     })?;
