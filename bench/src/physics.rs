@@ -533,8 +533,20 @@ impl BalanceAccumulator {
         if measured.iter().all(|v| v.is_finite()) {
             Self::add(&mut self.zmp, (measured - reference).norm());
         }
-        if let Some(previous) = previous {
-            let omega = (GRAVITY / true_com.z).sqrt();
+        // The pendulum's height is the CoM's above the feet in contact, not its world z: down
+        // a stair scene the controller's frame has the goal a metre below its origin, and the
+        // square root of a negative z made the DCM error NaN.
+        let feet = [
+            (EndEffector::LeftFoot, status.left_foot),
+            (EndEffector::RightFoot, status.right_foot),
+        ];
+        let (sum, count) = feet
+            .iter()
+            .filter(|(foot, _)| status.contacts[*foot as usize])
+            .fold((0.0, 0.0), |(sum, n), (_, pose)| (sum + pose[2], n + 1.0));
+        let height = true_com.z - sum / count;
+        if let Some(previous) = previous.filter(|_| count > 0.0 && height > 0.0) {
+            let omega = (GRAVITY / height).sqrt();
             let dcm = true_com.xy() + (true_com - previous).xy() / dt / omega;
             Self::add(&mut self.dcm, (dcm - Vector2::from(b.dcm_reference)).norm());
         }

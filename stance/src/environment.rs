@@ -17,6 +17,14 @@ pub struct SupportSurface {
 }
 
 impl SupportSurface {
+    /// Whether this is an unbounded horizontal plane at z = 0, the flat ground a stance source
+    /// generates on.
+    pub fn is_ground_plane(&self) -> bool {
+        self.polygon.is_none()
+            && self.pose.rotation * Vector3::z() == Vector3::z()
+            && self.pose.translation.z == 0.0
+    }
+
     /// The default environment's ground: the unbounded plane z = 0.
     pub fn ground() -> Self {
         Self {
@@ -166,11 +174,7 @@ impl Environment {
     /// Whether every surface is an unbounded horizontal plane at z = 0: the flat ground a stance
     /// source generates on, where the terrain pass has nothing to do.
     pub fn is_flat_ground(&self) -> bool {
-        self.surfaces.iter().all(|s| {
-            s.polygon.is_none()
-                && s.pose.rotation * Vector3::z() == Vector3::z()
-                && s.pose.translation.z == 0.0
-        })
+        self.surfaces.iter().all(SupportSurface::is_ground_plane)
     }
 
     /// The surface a point belongs to and its elevation there: of the surfaces under or above the

@@ -128,7 +128,7 @@ impl PostProcessedSequence {
         if sequence.environment != raw.environment {
             sequence.environment = raw.environment.clone();
         }
-        sequence.stances.truncate(raw.stances.len());
+        sequence.stances.truncate(poses.len());
         let mut previous = Vector3::zeros();
         for (i, (stance, root)) in raw.stances.iter().zip(&poses.roots).enumerate() {
             let translation = root.translation.vector - previous;

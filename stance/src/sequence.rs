@@ -203,6 +203,28 @@ impl PostProcessedSequence {
         self
     }
 
+    /// Ends the walk at its first stance with both feet in contact whose soles' mean lies
+    /// `distance` or more along +x: the goal of a walk on a scene's surfaces, in the walk's
+    /// frame (start at the origin, heading +x). A walk that never gets there is kept whole.
+    /// Returns whether it got there.
+    pub fn end_at(&mut self, distance: f64) -> bool {
+        let (left, right) = (
+            EndEffector::LeftFoot as usize,
+            EndEffector::RightFoot as usize,
+        );
+        let reached = (0..self.len()).find(|&i| {
+            let contacts = self.contacts(i);
+            let middle =
+                (self.targets[i][left].translation.x + self.targets[i][right].translation.x) / 2.0;
+            contacts[left] && contacts[right] && middle >= distance
+        });
+        if let Some(last) = reached {
+            self.sequence.stances.truncate(last + 1);
+            self.targets.truncate(last + 1);
+        }
+        reached.is_some()
+    }
+
     /// Contact flags of stance `i`, indexed by [`EndEffector`]. Panics if `i >= len()`.
     pub fn contacts(&self, i: usize) -> [bool; 4] {
         self.stances[i].contacts

@@ -60,24 +60,53 @@ pub fn walk_with<E: std::error::Error>(
     robot: &Robot,
     params: &PostProcessParams,
     request: &WalkRequest,
-    source: impl FnOnce(&GenerateOptions) -> Result<RawSequence, E>,
+    source: impl FnMut(&GenerateOptions) -> Result<RawSequence, E>,
 ) -> Result<PostProcessedSequence, WalkError<E>> {
     walk_on(robot, params, request, &[SupportSurface::ground()], source)
 }
 
+/// How many times longer than its path a walk on terrain is generated, in the order tried:
+/// the first whose post-processed walk reaches the path's end is ended there
+/// ([`PostProcessedSequence::end_at`]). With both feet on every stair the terrain pass takes
+/// more footholds per metre than the flat walk has, and it cannot add stances; a longer flat
+/// walk than needed would only bring in more of the source's sideways wander.
+pub const TERRAIN_DISTANCE_MARGINS: [f64; 3] = [1.0, 1.5, 2.0];
+
 /// [`walk_with`] on `surfaces` (a scene's, in the walk's frame: [`crate::Scene::walk_environment`]):
-/// the source's flat walk is post-processed onto them.
+/// the source's flat walk is post-processed onto them; unless they are the flat ground, it is
+/// generated longer ([`TERRAIN_DISTANCE_MARGINS`]) until it reaches `request.distance`, and
+/// ended there.
 pub fn walk_on<E: std::error::Error>(
     robot: &Robot,
     params: &PostProcessParams,
     request: &WalkRequest,
     surfaces: &[SupportSurface],
-    source: impl FnOnce(&GenerateOptions) -> Result<RawSequence, E>,
+    mut source: impl FnMut(&GenerateOptions) -> Result<RawSequence, E>,
 ) -> Result<PostProcessedSequence, WalkError<E>> {
-    let raw = source(&request.generate_options(params)).map_err(WalkError::Source)?;
-    PostProcessor::new(robot, params.clone())
-        .process(&raw.on_surfaces(surfaces))
-        .map_err(WalkError::PostProcess)
+    let options = request.generate_options(params);
+    let mut processor = PostProcessor::new(robot, params.clone());
+    let mut walk = |margin: f64| {
+        let longer = GenerateOptions {
+            distance: options.distance * margin,
+            ..options
+        };
+        let raw = source(&longer).map_err(WalkError::Source)?;
+        processor
+            .process(&raw.on_surfaces(surfaces))
+            .map_err(WalkError::PostProcess)
+    };
+    if surfaces.iter().all(SupportSurface::is_ground_plane) {
+        return walk(1.0);
+    }
+    let mut longest = None;
+    for margin in TERRAIN_DISTANCE_MARGINS {
+        let mut walked = walk(margin)?;
+        if walked.end_at(request.distance) {
+            return Ok(walked);
+        }
+        longest = Some(walked);
+    }
+    Ok(longest.expect("at least one margin"))
 }
 
 /// The walk of `request` from the synthetic human-like generator.

@@ -139,11 +139,11 @@ impl QpAssembler {
             .filter(|f| targets.contacts[**f as usize])
             .count();
         let m_ineq = match targets.balance {
-            Balance::SupportPolygon => {
+            Balance::SupportPolygon { .. } => {
                 self.polygon_from_contacts(robot, targets);
                 self.polygon.edge_count()
             }
-            Balance::ComHeight { .. } => 0,
+            Balance::Pendulum(_) => 0,
         };
         self.problem
             .set_active_rows(6 * feet_in_contact, m_ineq)
@@ -159,10 +159,12 @@ impl QpAssembler {
         // CoM x/y, and its height when the gait holds it.
         kinematics.com_jacobian(model, &mut self.com_jacobian);
         let com = kinematics.com();
-        let (com_rows, height, height_velocity) = match targets.balance {
-            Balance::SupportPolygon => (2, com.z, 0.0),
-            Balance::ComHeight { height, velocity } => (3, height, velocity),
+        let held = match targets.balance {
+            Balance::SupportPolygon { height } => height,
+            Balance::Pendulum(height) => Some(height),
         };
+        let (com_rows, height, height_velocity) =
+            held.map_or((2, com.z, 0.0), |held| (3, held.height, held.velocity));
         let com_velocity = [
             targets.com_velocity.x + config.com_gain * (targets.com.x - com.x),
             targets.com_velocity.y + config.com_gain * (targets.com.y - com.y),

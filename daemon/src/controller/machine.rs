@@ -76,12 +76,21 @@ impl Targets {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Balance {
     /// The CoM ground projection stays inside the support polygon (the static gait); the CoM
-    /// height is free.
-    SupportPolygon,
+    /// follows `height` when set (a climb between feet at different elevations, [`ComClimb`]),
+    /// else its height is free.
+    SupportPolygon { height: Option<ComHeight> },
     /// The CoM set-point moves like a pendulum whose ZMP stays in the support (the dynamic
-    /// gait), so no polygon constraint; the CoM follows this height (world z, m) with this
-    /// feed-forward vertical velocity (m/s).
-    ComHeight { height: f64, velocity: f64 },
+    /// gait), so no polygon constraint; the CoM follows this height.
+    Pendulum(ComHeight),
+}
+
+/// A height the QP's CoM task follows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ComHeight {
+    /// World z (m).
+    pub height: f64,
+    /// Feed-forward vertical velocity (m/s).
+    pub velocity: f64,
 }
 
 /// Result of one state-machine update.
@@ -93,6 +102,37 @@ pub(crate) enum Progress {
     /// A fault the walk answers with a controlled stop (dynamic gait): it keeps running until
     /// the robot rests on both feet, then ends `Done`.
     Stopping(FaultCode),
+}
+
+/// The static gait's CoM height change while a shift hands the weight to a foot at another
+/// elevation: the posture reference, made on flat ground, would leave the CoM at the lower
+/// foot's height and the leg on the step carrying it deeply bent (JVRC-1's knee then sits at
+/// its torque limit when the other foot lifts); the height rises (or falls) by the elevation
+/// difference with the shift instead, while both feet still carry the weight. After the shift
+/// the height is free again: held on through the single support that follows, JVRC-1 rocked
+/// on its stance foot and tipped sooner (MuJoCo, `stairs-up-10cm`, seed 0).
+#[derive(Clone, Copy, Debug)]
+struct ComClimb {
+    /// Estimated CoM height at the start of the shift (m).
+    from: f64,
+    /// Elevation of the foot taking the weight minus that of the foot leaving (m).
+    rise: f64,
+}
+
+impl ComClimb {
+    /// The height target `time` (s) into a shift lasting `duration` (s): linear, then held
+    /// while the shift settles.
+    fn height(&self, time: f64, duration: f64) -> ComHeight {
+        let progress = (time / duration).clamp(0.0, 1.0);
+        ComHeight {
+            height: self.from + self.rise * progress,
+            velocity: if progress < 1.0 {
+                self.rise / duration
+            } else {
+                0.0
+            },
+        }
+    }
 }
 
 /// A CoM shift that stalled short of its goal (joint limits) still completes once it has sat
@@ -122,6 +162,9 @@ pub(crate) struct StateMachine {
     motion_is_via: bool,
     com_motion: PointTrajectory,
     com_time: f64,
+    /// The CoM height change of the current shift, if it hands the weight to a foot at another
+    /// elevation; outside a shift, and with `None`, the height is free (the posture's).
+    com_climb: Option<ComClimb>,
     free_targets: [Option<Isometry3<f64>>; 4],
     /// Released hands, carried along with the pelvis: their pose relative to its planar frame
     /// (x, y, yaw) at release. Planar, so the pelvis roll of ARMAR-4's hip strategy does not
@@ -152,6 +195,7 @@ impl StateMachine {
             motion_is_via: false,
             com_motion: PointTrajectory::new(Vector2::zeros(), Vector2::zeros(), 1.0),
             com_time: 0.0,
+            com_climb: None,
             free_targets: [None; 4],
             carried: [None; 4],
             targets: Targets {
@@ -161,7 +205,7 @@ impl StateMachine {
                 com_velocity: Vector2::zeros(),
                 end_effectors: [None; 4],
                 unloading: None,
-                balance: Balance::SupportPolygon,
+                balance: Balance::SupportPolygon { height: None },
                 contact_velocity: [[0.0; 6]; 2],
                 torso_posture_weight: None,
             },
@@ -279,6 +323,7 @@ impl StateMachine {
         let com = feedback.com.xy();
         self.com_motion = PointTrajectory::new(com, com, self.config.min_motion_s);
         self.com_time = 0.0;
+        self.com_climb = None;
         self.begin_transition(feedback);
     }
 
@@ -362,6 +407,10 @@ impl StateMachine {
                 let duration = c.min_motion_s.max((goal - start).norm() / c.com_speed);
                 self.com_motion = PointTrajectory::new(start, goal, duration);
                 self.com_time = 0.0;
+                self.com_climb = self.climb_of_shift(excluded).map(|rise| ComClimb {
+                    from: feedback.com.z,
+                    rise,
+                });
                 duration
             }
             (Phase::Unload, Some(foot)) => {
@@ -465,6 +514,19 @@ impl StateMachine {
                 )
             });
         sum / count
+    }
+
+    /// The elevation (m) the weight climbs when a shift hands it from foot `lifting` to the
+    /// other foot standing higher (negative: lower), `None` between feet on one level (within
+    /// [`STEP_HEIGHT_M`]) or when no foot is lifting.
+    fn climb_of_shift(&self, lifting: Option<EndEffector>) -> Option<f64> {
+        let lifting = lifting.filter(|e| e.is_foot())?;
+        let staying = FEET
+            .into_iter()
+            .find(|&f| f != lifting && self.targets.contacts[f as usize])?;
+        let rise = self.targets.anchors[staying as usize].translation.z
+            - self.targets.anchors[lifting as usize].translation.z;
+        (rise.abs() > STEP_HEIGHT_M).then_some(rise)
     }
 
     /// The polygon of the feet in contact except `excluded`.
@@ -575,6 +637,13 @@ impl StateMachine {
         self.targets.com = com;
         self.targets.com_velocity = com_velocity;
         let step = self.started.then(|| self.current_step());
+        let shifting = step.is_some_and(|step| step.phase == Phase::ShiftCom);
+        self.targets.balance = Balance::SupportPolygon {
+            height: self
+                .com_climb
+                .filter(|_| shifting)
+                .map(|climb| climb.height(self.com_time, self.com_motion.duration())),
+        };
         let moving = step.and_then(|step| match step.phase {
             Phase::Unload | Phase::Lift | Phase::Swing | Phase::Lower | Phase::Reach => {
                 step.end_effector
@@ -633,4 +702,29 @@ fn raised(pose: &Isometry3<f64>, height: f64) -> Isometry3<f64> {
         Translation3::from(pose.translation.vector + Vector3::z() * height),
         pose.rotation,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_climb_raises_the_com_with_the_shift_then_holds_it() {
+        let climb = ComClimb {
+            from: 0.85,
+            rise: 0.1,
+        };
+        let at = |t| climb.height(t, 2.0);
+        assert_eq!(at(0.0).height, 0.85);
+        assert!((at(1.0).height - 0.9).abs() < 1e-12);
+        assert!((at(1.0).velocity - 0.05).abs() < 1e-12);
+        assert!((at(3.0).height - 0.95).abs() < 1e-12);
+        assert_eq!(at(3.0).velocity, 0.0);
+        // Down a stair, the same the other way.
+        let down = ComClimb {
+            from: 0.85,
+            rise: -0.1,
+        };
+        assert!((down.height(2.0, 2.0).height - 0.75).abs() < 1e-12);
+    }
 }

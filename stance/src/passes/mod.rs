@@ -164,7 +164,7 @@ pub fn run_passes_observed(
     after(Pass::LimitToMaxStepSize, poses);
     limit_orthogonal_feet_distance(poses, &path, params.o_min, params.o_max);
     after(Pass::LimitOrthogonalFeetDistance, poses);
-    place_on_terrain(poses, environment, sole);
+    place_on_terrain(poses, environment, sole, params.s_max);
     after(Pass::PlaceOnTerrain, poses);
     limit_swing_foot_height(poses, environment, sole.length, params.h_min, params.h_max);
     after(Pass::LimitSwingFootHeight, poses);

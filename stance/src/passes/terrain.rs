@@ -25,6 +25,9 @@ pub const HEEL_MARGIN_M: f64 = 0.02;
 /// heel, because there the toe meets the next riser of a stair going up.
 pub const TOE_MARGIN_M: f64 = 0.03;
 
+/// A foot this close (m) to the end of its surface's fit interval has come up to the edge.
+const EDGE_REACHED_M: f64 = 0.01;
+
 /// A surface shorter than this many sole lengths along the path is *short* (a stair tread):
 /// two feet side by side fit on it, but a step from one to the other on it does not, so a
 /// walker puts one foot per stair.
@@ -45,7 +48,11 @@ pub const SHORT_SURFACE_SOLES: f64 = 2.0;
 ///    surface under its sole centre (the nearest along the path if none), with three rules, in
 ///    order: (i) no surface is skipped: the foot lands on the other foot's surface or the next
 ///    one forward along the path; (ii) one foot per short surface ([`SHORT_SURFACE_SOLES`]): not
-///    on the one the other foot stands on, but on the next; (iii) the sole centre is clamped into
+///    on the one the other foot stands on, but on the next — unless that step would be longer
+///    than `s_max` and the foot is not on the other's surface yet: then it joins the other foot
+///    there, both feet on each stair (the lead foot goes up, the other follows onto the same
+///    tread, as the anchors' controllers climb), each step one tread long; (iii) the sole
+///    centre is clamped into
 ///    its surface's fit interval along the path: where the sole, lengthened by
 ///    [`HEEL_MARGIN_M`] behind and [`TOE_MARGIN_M`] ahead, lies over the surface — for a sole
 ///    along the path and a surface edge across it, `[start + HEEL_MARGIN_M + L/2, end −
@@ -54,7 +61,8 @@ pub const SHORT_SURFACE_SOLES: f64 = 2.0;
 ///    foot goes on to the next surface instead: short steps would otherwise stall at an edge,
 ///    each landing short of it.
 ///    A landing's shift moves everything after it, as pass 7's do (`shift_landings`), so a
-///    step made longer by rule (ii) can exceed `s_max`.
+///    step made longer by rule (ii) can exceed `s_max`: a tread deeper than `s_max` is a step
+///    of its depth whatever the rule.
 /// 2. **Elevation and orientation.** Every contact sole is put on its surface's elevation, and
 ///    on a tilted surface made parallel to it (yaw kept; passes 3 and 4 on the real surface).
 ///    Each stance's root and free hands rise by its support elevation (the mean elevation of
@@ -67,7 +75,12 @@ pub const SHORT_SURFACE_SOLES: f64 = 2.0;
 /// the walk was generated on (unbounded planes z = 0) there is nothing to fit and nothing to
 /// lift: the pass returns at once (and on a bounded floor at z = 0 around the walk it changes
 /// nothing either).
-pub fn place_on_terrain(poses: &mut PoseSequence, environment: &Environment, sole: &SoleRectangle) {
+pub fn place_on_terrain(
+    poses: &mut PoseSequence,
+    environment: &Environment,
+    sole: &SoleRectangle,
+    s_max: f64,
+) {
     if environment.is_flat_ground() {
         return;
     }
@@ -80,6 +93,7 @@ pub fn place_on_terrain(poses: &mut PoseSequence, environment: &Environment, sol
             environment,
             path,
             sole,
+            s_max,
             surface: [None; 2],
             along: [None; 2],
         },
@@ -126,6 +140,8 @@ struct Footholds<'a> {
     environment: &'a Environment,
     path: &'a PathFrame,
     sole: &'a SoleRectangle,
+    /// The step limit (pass 7's `s_max`): one foot per stair only where its steps keep to it.
+    s_max: f64,
     /// Index of the surface each foot last landed on.
     surface: [Option<usize>; 2],
     /// Along-path position of each foot's last landing.
@@ -143,6 +159,12 @@ impl Footholds<'_> {
             from: start,
             to: end,
         })
+    }
+
+    /// Whether the surface of `extent` is short along the path, a stair tread
+    /// ([`SHORT_SURFACE_SOLES`]).
+    fn is_short(&self, extent: &Extent) -> bool {
+        extent.to - extent.from < SHORT_SURFACE_SOLES * self.sole.length
     }
 
     /// Every surface's extent on the line `lateral` to the left of the path.
@@ -163,11 +185,18 @@ impl Footholds<'_> {
             .min_by(|a, b| a.from.total_cmp(&b.from))
     }
 
-    /// The surface foot `f` lands on (rules i and ii).
-    fn choose(&self, f: usize, along: f64, lateral: f64) -> Option<Extent> {
+    /// The surface foot `f` lands on (rules i and ii), and whether it lands there beside the
+    /// other foot on purpose (both feet on a stair), where an edge does not stall it.
+    fn choose(
+        &self,
+        f: usize,
+        along: f64,
+        lateral: f64,
+        sole: &Isometry3<f64>,
+    ) -> Option<(Extent, bool)> {
         let candidate = self.under(along, lateral)?;
         let Some(other) = self.surface[1 - f].and_then(|k| self.extent(k, lateral)) else {
-            return Some(candidate);
+            return Some((candidate, false));
         };
         let next = self.next(&other, lateral);
         let chosen = match next {
@@ -175,16 +204,39 @@ impl Footholds<'_> {
             _ if candidate.from < other.from => other,
             _ => candidate,
         };
-        let short = other.to - other.from < SHORT_SURFACE_SOLES * self.sole.length;
-        if chosen.surface == other.surface && short {
-            return Some(next.unwrap_or(other));
+        if !self.is_short(&other) {
+            return Some((chosen, false));
         }
-        Some(chosen)
+        let Some(next) = next else {
+            return Some((other, false));
+        };
+        if self.joins_the_other(f, &other, &next, along, sole) {
+            return Some((other, true));
+        }
+        Some((next, false))
+    }
+
+    /// Both feet on each stair: foot `f`, not yet on the other foot's short surface `other`,
+    /// joins it there when going on to `next` (one foot per stair) would make its step longer
+    /// than `s_max`.
+    fn joins_the_other(
+        &self,
+        f: usize,
+        other: &Extent,
+        next: &Extent,
+        along: f64,
+        sole: &Isometry3<f64>,
+    ) -> bool {
+        self.surface[f] != Some(other.surface)
+            && self.along[f]
+                .is_some_and(|from| self.fit(next.surface, along, sole) - from > self.s_max)
     }
 
     /// Rule (iii): `along` clamped into surface `k`'s fit interval for `sole`: the sole centre
     /// positions where each corner of the sole lengthened by the margins lies over the surface
-    /// (on the corner's own line parallel to the path; exact for convex surfaces).
+    /// (on the corner's own line parallel to the path; exact for convex surfaces). On a short
+    /// surface (a tread), the interval's middle: the most room at both edges for the error of
+    /// the foot's landing.
     fn fit(&self, k: usize, along: f64, sole: &Isometry3<f64>) -> f64 {
         let lateral = self.path.lateral(&sole.translation.vector);
         let (back, front) = (
@@ -202,7 +254,8 @@ impl Footholds<'_> {
                 hi = hi.min(extent.to - ahead);
             }
         }
-        if lo <= hi {
+        let short = self.extent(k, lateral).is_some_and(|e| self.is_short(&e));
+        if lo <= hi && !short {
             along.clamp(lo, hi)
         } else {
             (lo + hi) / 2.0
@@ -213,23 +266,40 @@ impl Footholds<'_> {
 impl LandingRule for Footholds<'_> {
     type Placed = Option<usize>;
 
-    fn place(&self, f: usize, along: f64, sole: &Isometry3<f64>) -> (f64, Option<usize>) {
+    fn place(&self, f: usize, flat: f64, sole: &Isometry3<f64>) -> (f64, Option<usize>) {
+        // The landings shifted before this one can stretch its step past `s_max` (another
+        // foot's landing pushed on to a tread moves it too): held to the limit first, as
+        // pass 7 held the flat walk; a surface then takes it further only where it must.
+        let along = self.along[f].map_or(flat, |from| flat.min(from + self.s_max));
         let lateral = self.path.lateral(&sole.translation.vector);
-        let Some(extent) = self.choose(f, along, lateral) else {
+        let Some((extent, beside)) = self.choose(f, along, lateral, sole) else {
             return (0.0, None);
         };
         let fitted = self.fit(extent.surface, along, sole);
-        // Clamped back by more than half its advance on the other foot, the walk would stall
-        // at the edge (each landing again short of it): on to the next surface instead.
-        let stalled = self.along[1 - f]
-            .is_some_and(|other| along > other && fitted - other < (along - other) / 2.0);
-        if let Some(next) = self.next(&extent, lateral).filter(|_| stalled) {
-            return (
-                self.fit(next.surface, along, sole) - along,
-                Some(next.surface),
-            );
+        // Clamped back by more than half its advance on the other foot, on the surface that
+        // foot stands on, the walk would stall at the edge (each landing again short of it):
+        // on to the next surface instead (which rule (i) allows) — unless it is a tread that
+        // far ahead of this foot that the step would be longer than `s_max`, and this foot can
+        // still come up to the edge: it does, and goes on from there next time (onto the first
+        // stair, JVRC-1's static steps reached 0.37 m where its s_max is 0.24 m).
+        let stalled = !beside
+            && self.surface[1 - f] == Some(extent.surface)
+            && self.along[1 - f]
+                .is_some_and(|other| along > other && fitted - other < (along - other) / 2.0);
+        let at_the_edge = self.along[f].is_none_or(|from| from >= fitted - EDGE_REACHED_M);
+        let onward = self
+            .next(&extent, lateral)
+            .filter(|_| stalled)
+            .map(|next| (self.fit(next.surface, along, sole), next))
+            .filter(|(at, next)| {
+                at_the_edge
+                    || !self.is_short(next)
+                    || self.along[f].is_none_or(|from| at - from <= self.s_max)
+            });
+        match onward {
+            Some((at, next)) => (at - flat, Some(next.surface)),
+            None => (fitted - flat, Some(extent.surface)),
         }
-        (fitted - along, Some(extent.surface))
     }
 
     fn landed(&mut self, f: usize, along: f64, placed: Option<usize>) {
@@ -328,6 +398,10 @@ mod tests {
     use kinematics::robot::EndEffector::{LeftFoot, LeftHand, RightFoot, RightHand};
     use nalgebra::UnitQuaternion;
 
+    /// A step limit that lets the walk put one foot per stair on [`stairs`] (steps of two
+    /// treads, 0.6 m).
+    const ONE_FOOT: f64 = 1.0;
+
     /// A floor to x = 0.5, three 0.3 m treads rising 0.1 m each, a landing from x = 1.4.
     fn stairs() -> Environment {
         Environment {
@@ -376,6 +450,14 @@ mod tests {
             .collect()
     }
 
+    /// The first footholds of `flat_walk(&[0.2, 0.4, ...])` on [`stairs`]: both feet at the
+    /// start, then up to the floor's edge (its fit interval ends at 0.37).
+    const TO_THE_FLOOR_EDGE: [[f64; 2]; 4] = [[0.0, 0.0], [0.0, 0.0], [0.2, 0.0], [0.37, 0.0]];
+
+    /// The first footholds of `flat_walk(&[0.12, 0.24, ...])`: both feet at the start, then
+    /// two 0.12 m steps.
+    const SHORT_STEPS: [[f64; 2]; 4] = [[0.0, 0.0], [0.0, 0.0], [0.12, 0.0], [0.24, 0.0]];
+
     fn assert_footholds(poses: &PoseSequence, expected: &[[f64; 2]]) {
         let found = footholds(poses);
         assert_eq!(found.len(), expected.len(), "{found:?}");
@@ -394,44 +476,38 @@ mod tests {
         rotated(&mut p, 4, LeftFoot, [0.0, 0.0, 0.2]);
         p.contacts[2][RightHand as usize] = true;
         let before = p.clone();
-        place_on_terrain(&mut p, &Environment::default(), &SOLE);
+        place_on_terrain(&mut p, &Environment::default(), &SOLE, ONE_FOOT);
         assert_eq!(p, before);
         // Not by the early return alone: a floor at z = 0 with room around the walk.
         let floor = Environment {
             surfaces: vec![block("floor", -1.0, 3.0, 0.0)],
             hand_affordances: Vec::new(),
         };
-        place_on_terrain(&mut p, &floor, &SOLE);
+        place_on_terrain(&mut p, &floor, &SOLE, ONE_FOOT);
         assert_eq!(p, before);
     }
 
     #[test]
     fn stairs_take_one_foot_per_tread_with_the_toes_clear_of_the_risers() {
         let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
-        place_on_terrain(&mut p, &stairs(), &SOLE);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
         // Floor: its fit interval ends 0.03 + 0.1 before the riser at 0.5 (0.4 → 0.37). Each
-        // tread's interval is [from + 0.12, to − 0.13]: a landing on the tread the other foot
-        // stands on goes on to the next one, to the interval's start.
-        assert_footholds(
-            &p,
-            &[
-                [0.0, 0.0],
-                [0.0, 0.0],
-                [0.2, 0.0],
-                [0.37, 0.0],
-                [0.62, 0.1],
-                [0.92, 0.2],
-                [1.22, 0.3],
-                [1.52, 0.4],
-                [1.67, 0.4],
-            ],
-        );
-        // The left foot swings from the floor (0.37) to tread-2 (0.92) in stance 7: half-way,
+        // tread's interval is [from + 0.12, to − 0.13], and a foot goes to its middle: a
+        // landing on the tread the other foot stands on goes on to the next one.
+        let up = [
+            [0.645, 0.1],
+            [0.945, 0.2],
+            [1.245, 0.3],
+            [1.52, 0.4],
+            [1.67, 0.4],
+        ];
+        assert_footholds(&p, &[&TO_THE_FLOOR_EDGE[..], &up].concat());
+        // The left foot swings from the floor (0.37) to tread-2 (0.945) in stance 7: half-way,
         // 0.05 m above tread-2. The root of the double support that follows rises by the mean
         // of tread-1 and tread-2.
         let swing = p.pose(7, LeftFoot).translation.vector;
         assert!(
-            (swing.x - 0.645).abs() < 1e-12 && (swing.z - 0.25).abs() < 1e-12,
+            (swing.x - 0.6575).abs() < 1e-12 && (swing.z - 0.25).abs() < 1e-12,
             "{swing:?}"
         );
         let root = p.roots[8].translation.vector;
@@ -439,37 +515,60 @@ mod tests {
     }
 
     #[test]
+    fn a_step_limit_shorter_than_two_treads_puts_both_feet_on_each_stair() {
+        let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
+        place_on_terrain(&mut p, &stairs(), &SOLE, 0.4);
+        // The right foot goes up to tread-1 (the middle of its fit interval, 0.645); the left,
+        // 0.575 m on to tread-2 from the floor's 0.37 with one foot per stair, joins it on
+        // tread-1 instead, beside it, not stalled; the right leads on, one tread (0.30 m) per
+        // step.
+        let up = [
+            [0.645, 0.1],
+            [0.645, 0.1],
+            [0.945, 0.2],
+            [0.945, 0.2],
+            [1.245, 0.3],
+        ];
+        assert_footholds(&p, &[&TO_THE_FLOOR_EDGE[..], &up].concat());
+    }
+
+    #[test]
     fn short_steps_do_not_stall_at_an_edge() {
         let mut p = flat_walk(&[0.12, 0.24, 0.36, 0.48, 0.6, 0.72, 0.84, 0.96]);
-        place_on_terrain(&mut p, &stairs(), &SOLE);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
         // 0.48 is clamped back to the floor's 0.37, 1 cm of its 12 cm advance on the right foot
         // (0.36): tread-1 instead, then one foot per tread.
-        assert_footholds(
-            &p,
-            &[
-                [0.0, 0.0],
-                [0.0, 0.0],
-                [0.12, 0.0],
-                [0.24, 0.0],
-                [0.36, 0.0],
-                [0.62, 0.1],
-                [0.92, 0.2],
-                [1.22, 0.3],
-                [1.52, 0.4],
-                [1.64, 0.4],
-            ],
-        );
+        let on = [
+            [0.36, 0.0],
+            [0.645, 0.1],
+            [0.945, 0.2],
+            [1.245, 0.3],
+            [1.52, 0.4],
+        ];
+        assert_footholds(&p, &[&SHORT_STEPS[..], &on, &[[1.64, 0.4]]].concat());
+    }
+
+    #[test]
+    fn a_foot_comes_up_to_the_edge_before_a_step_onto_a_tread_longer_than_s_max() {
+        let mut p = flat_walk(&[0.12, 0.24, 0.4, 0.48, 0.6, 0.72]);
+        place_on_terrain(&mut p, &stairs(), &SOLE, 0.25);
+        // The left foot, stalled at the floor's edge (0.37) beside the right, would go on to
+        // tread-1 (0.645), 0.405 m from 0.24: it comes up to the edge instead. The right,
+        // already there, goes on (0.275 m, the shortest step onto the tread), and the left
+        // joins it.
+        let on = [[0.37, 0.0], [0.37, 0.0], [0.645, 0.1], [0.645, 0.1]];
+        assert_footholds(&p, &[&SHORT_STEPS[..], &on].concat());
     }
 
     #[test]
     fn a_long_step_does_not_skip_a_tread() {
         let mut p = flat_walk(&[0.2, 0.3, 1.0]);
-        place_on_terrain(&mut p, &stairs(), &SOLE);
-        // The right foot would land on tread-2 while the left stands on the floor: tread-1, as
-        // far forward as it fits.
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
+        // The right foot would land on tread-2 while the left stands on the floor: tread-1, in
+        // the middle of its fit interval.
         let right = p.pose(p.len() - 1, RightFoot).translation.vector;
         assert!(
-            (right.x - 0.67).abs() < 1e-12 && (right.z - 0.1).abs() < 1e-12,
+            (right.x - 0.645).abs() < 1e-12 && (right.z - 0.1).abs() < 1e-12,
             "{right:?}"
         );
     }
@@ -481,7 +580,7 @@ mod tests {
             contacts[RightHand as usize] = true;
         }
         let before = p.clone();
-        place_on_terrain(&mut p, &stairs(), &SOLE);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
         let rise =
             |i: usize, e: EndEffector| p.pose(i, e).translation.z - before.pose(i, e).translation.z;
         // Stance 4: both feet on the floor; 6: the left foot on tread-1 (0.1), the right on the
@@ -512,7 +611,7 @@ mod tests {
             stance([-0.05, 0.1, 0.0], [-0.05, -0.1, 0.0], BOTH),
             stance([-0.05, 0.1, 0.0], [0.2, -0.1, 0.0], BOTH),
         ]);
-        place_on_terrain(&mut p, &stairs(), &SOLE);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
         let (left, right) = (p.pose(0, LeftFoot), p.pose(0, RightFoot));
         let middle = (left.translation.vector + right.translation.vector) / 2.0;
         assert!(middle.xy().norm() < 1e-12, "{middle}");
@@ -540,7 +639,7 @@ mod tests {
             stance([0.3, 0.1, 0.0], [0.3, -0.1, 0.0], BOTH),
         ]);
         rotated(&mut p, 1, LeftFoot, [0.0, 0.0, 0.1]);
-        place_on_terrain(&mut p, &env, &SOLE);
+        place_on_terrain(&mut p, &env, &SOLE, ONE_FOOT);
         let left = p.pose(1, LeftFoot);
         assert!((left.translation.z - 0.3 * slope.tan()).abs() < 1e-12);
         let normal = env.surfaces[0].pose.rotation * Vector3::z();
@@ -564,7 +663,7 @@ mod tests {
             stance([0.6, 0.1, 0.0], [0.6, -0.1, 0.0], BOTH),
         ]);
         let before = p.clone();
-        place_on_terrain(&mut p, &stairs(), &SOLE);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
         let rise = |i: usize| p.roots[i].translation.z - before.roots[i].translation.z;
         assert!(rise(0).abs() < 1e-12 && (rise(2) - 0.1).abs() < 1e-12);
         assert!((rise(1) - 0.05).abs() < 1e-12, "{}", rise(1));

@@ -46,7 +46,9 @@ use super::sensing::{DcmEstimator, TiltRate, pressure_centre, tilted_com};
 use super::stabilizer::{Measured, Stabilizer};
 use super::swing::SwingTrajectory;
 use crate::controller::config::ControllerConfig;
-use crate::controller::machine::{Balance, Feedback, PoseTarget, Progress, Targets, heading_frame};
+use crate::controller::machine::{
+    Balance, ComHeight, Feedback, PoseTarget, Progress, Targets, heading_frame,
+};
 use crate::controller::sequence::PreparedSequence;
 use crate::controller::sequencer::on_both_feet;
 use crate::controller::status::{BalanceStatus, FaultCode, Phase};
@@ -627,10 +629,10 @@ impl DynamicWalker {
         self.targets.com_velocity = command.com_velocity;
         let (elevation, rate) =
             support_elevation(&self.plan().footsteps.phases, self.phase, self.clock);
-        self.targets.balance = Balance::ComHeight {
+        self.targets.balance = Balance::Pendulum(ComHeight {
             height: elevation + self.plan().com_height,
             velocity: rate,
-        };
+        });
         self.targets.torso_posture_weight = self.plan().config.torso_posture_weight;
         if self.blind {
             // No force-torque to comply with: the feet hold their anchors, and the compliance
