@@ -685,7 +685,6 @@ pub(crate) fn heading_frame(pose: &Isometry3<f64>) -> Isometry3<f64> {
     planar_frame(std::iter::once(pose))
 }
 
-/// `pose` moved up by `height` along world z.
 /// A height difference between where a foot lifts off and where it lands counts as a step up
 /// or down (a stair or a ramp) above this (m); below it the swing is the flat-ground one. Both
 /// gaits shape their swings by it.
@@ -697,6 +696,7 @@ fn climb_above_step(height: f64) -> f64 {
     if height > STEP_HEIGHT_M { height } else { 0.0 }
 }
 
+/// `pose` moved up by `height` along world z.
 fn raised(pose: &Isometry3<f64>, height: f64) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::from(pose.translation.vector + Vector3::z() * height),
