@@ -32,8 +32,8 @@ pub(crate) struct WatchOptions<'a> {
     pub on_status: &'a dyn Fn(&DaemonStatus),
     /// Where the controller's world frame lies in the simulator's: the controller sets it up
     /// on the feet it stands on, the simulator puts the robot at a scene's start (identity on
-    /// the flat floor). The trace's controller points are mapped by it, so the drift compares
-    /// like with like.
+    /// the flat floor). The trace's controller points and the stances' targets are mapped by it,
+    /// so the drift, the footholds and the final position compare like with like.
     pub controller_frame: Isometry3<f64>,
 }
 
@@ -53,7 +53,8 @@ pub(crate) struct WatchedWalk {
     pub states: Vec<SimTruth>,
     /// The simulator's verdict; `None` when no simulator published its truth (a real robot).
     pub verdict: Option<Verdict>,
-    /// The stances' targets in the world (as the controller aligned the sequence).
+    /// The stances' targets in the simulator's world (as the controller aligned the sequence,
+    /// mapped by [`WatchOptions::controller_frame`]).
     pub targets: Vec<Points>,
     /// The walk's statuses as a Fig. 6 trace, with the simulator's truth where it pairs.
     pub trace: Vec<TraceSample>,
@@ -93,6 +94,10 @@ pub(crate) fn watch_walk(
         sequence,
         &[pose_of(&start.left_foot), pose_of(&start.right_foot)],
     );
+    // Into the simulator's frame, where the footholds and Fig. 6 compare them with its truth.
+    for target in &mut targets {
+        *target = target.transformed(&options.controller_frame);
+    }
     let wall = Instant::now();
     let submitted_ns = shm_types::monotonic_ns();
     let id = client.submit_json(&sequence.to_json_string())?;

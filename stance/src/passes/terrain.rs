@@ -18,8 +18,11 @@ use crate::environment::Environment;
 use crate::geometry::PathFrame;
 use crate::poses::{FEET, HANDS, PoseSequence};
 
-/// Room (m) left between a foothold's heel and the back edge of its surface.
-pub const HEEL_MARGIN_M: f64 = 0.02;
+/// Room (m) left between a foothold's heel and the back edge of its surface: the edge the
+/// foot comes over. Under MuJoCo a dynamic JVRC-1 landing falls 3–4 cm short of its foothold
+/// late in a walk (odometry drift); with 0.02 m the heel of the step off the last stair came
+/// down on the stair's edge.
+pub const HEEL_MARGIN_M: f64 = 0.05;
 
 /// Room (m) left between a foothold's toe and the front edge of its surface: more than at the
 /// heel, because there the toe meets the next riser of a stair going up.
@@ -210,7 +213,7 @@ impl Footholds<'_> {
         let Some(next) = next else {
             return Some((other, false));
         };
-        if self.joins_the_other(f, &other, &next, along, sole) {
+        if self.joins_the_other(f, &other, &next, along, lateral, sole) {
             return Some((other, true));
         }
         Some((next, false))
@@ -225,11 +228,32 @@ impl Footholds<'_> {
         other: &Extent,
         next: &Extent,
         along: f64,
+        lateral: f64,
         sole: &Isometry3<f64>,
     ) -> bool {
         self.surface[f] != Some(other.surface)
-            && self.along[f]
-                .is_some_and(|from| self.fit(next.surface, along, sole) - from > self.s_max)
+            && self.along[f].is_some()
+            && self.fit(next.surface, along, sole) > self.farthest(f, next.surface, lateral)
+    }
+
+    /// The farthest along-path landing of foot `f` on surface `k` (on the line `lateral`) that
+    /// keeps its step within `s_max`. The limit is on the step in space, as the controller's
+    /// `max_step_m` measures it: a step that also rises or falls by `h` reaches
+    /// `√(s_max² − h²)` along the path (a 0.48 m limit, 0.456 m down a 0.15 m stair).
+    fn farthest(&self, f: usize, k: usize, lateral: f64) -> f64 {
+        let (Some(from), Some(at)) = (self.along[f], self.surface[f]) else {
+            return f64::INFINITY;
+        };
+        let elevation = |k: usize, along: f64| {
+            let point = self.path.point(along, lateral);
+            self.environment.surfaces[k].plane_elevation_at(point.x, point.y)
+        };
+        let reach = |rise: f64| (self.s_max.powi(2) - rise.powi(2)).max(0.0).sqrt();
+        let flat = from + self.s_max;
+        match (elevation(at, from), elevation(k, flat)) {
+            (Some(start), Some(end)) => from + reach(end - start),
+            _ => flat,
+        }
     }
 
     /// Rule (iii): `along` clamped into surface `k`'s fit interval for `sole`: the sole centre
@@ -275,6 +299,7 @@ impl LandingRule for Footholds<'_> {
         let Some((extent, beside)) = self.choose(f, along, lateral, sole) else {
             return (0.0, None);
         };
+        let along = along.min(self.farthest(f, extent.surface, lateral));
         let fitted = self.fit(extent.surface, along, sole);
         // Clamped back by more than half its advance on the other foot, on the surface that
         // foot stands on, the walk would stall at the edge (each landing again short of it):
@@ -294,7 +319,7 @@ impl LandingRule for Footholds<'_> {
             .filter(|(at, next)| {
                 at_the_edge
                     || !self.is_short(next)
-                    || self.along[f].is_none_or(|from| at - from <= self.s_max)
+                    || *at <= self.farthest(f, next.surface, lateral)
             });
         match onward {
             Some((at, next)) => (at - flat, Some(next.surface)),
@@ -492,22 +517,22 @@ mod tests {
         let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
         place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
         // Floor: its fit interval ends 0.03 + 0.1 before the riser at 0.5 (0.4 → 0.37). Each
-        // tread's interval is [from + 0.12, to − 0.13], and a foot goes to its middle: a
+        // tread's interval is [from + 0.15, to − 0.13], and a foot goes to its middle: a
         // landing on the tread the other foot stands on goes on to the next one.
         let up = [
-            [0.645, 0.1],
-            [0.945, 0.2],
-            [1.245, 0.3],
-            [1.52, 0.4],
-            [1.67, 0.4],
+            [0.66, 0.1],
+            [0.96, 0.2],
+            [1.26, 0.3],
+            [1.55, 0.4],
+            [1.70, 0.4],
         ];
         assert_footholds(&p, &[&TO_THE_FLOOR_EDGE[..], &up].concat());
-        // The left foot swings from the floor (0.37) to tread-2 (0.945) in stance 7: half-way,
+        // The left foot swings from the floor (0.37) to tread-2 (0.96) in stance 7: half-way,
         // 0.05 m above tread-2. The root of the double support that follows rises by the mean
         // of tread-1 and tread-2.
         let swing = p.pose(7, LeftFoot).translation.vector;
         assert!(
-            (swing.x - 0.6575).abs() < 1e-12 && (swing.z - 0.25).abs() < 1e-12,
+            (swing.x - 0.665).abs() < 1e-12 && (swing.z - 0.25).abs() < 1e-12,
             "{swing:?}"
         );
         let root = p.roots[8].translation.vector;
@@ -518,16 +543,16 @@ mod tests {
     fn a_step_limit_shorter_than_two_treads_puts_both_feet_on_each_stair() {
         let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
         place_on_terrain(&mut p, &stairs(), &SOLE, 0.4);
-        // The right foot goes up to tread-1 (the middle of its fit interval, 0.645); the left,
-        // 0.575 m on to tread-2 from the floor's 0.37 with one foot per stair, joins it on
+        // The right foot goes up to tread-1 (the middle of its fit interval, 0.66); the left,
+        // 0.59 m on to tread-2 from the floor's 0.37 with one foot per stair, joins it on
         // tread-1 instead, beside it, not stalled; the right leads on, one tread (0.30 m) per
         // step.
         let up = [
-            [0.645, 0.1],
-            [0.645, 0.1],
-            [0.945, 0.2],
-            [0.945, 0.2],
-            [1.245, 0.3],
+            [0.66, 0.1],
+            [0.66, 0.1],
+            [0.96, 0.2],
+            [0.96, 0.2],
+            [1.26, 0.3],
         ];
         assert_footholds(&p, &[&TO_THE_FLOOR_EDGE[..], &up].concat());
     }
@@ -540,12 +565,12 @@ mod tests {
         // (0.36): tread-1 instead, then one foot per tread.
         let on = [
             [0.36, 0.0],
-            [0.645, 0.1],
-            [0.945, 0.2],
-            [1.245, 0.3],
-            [1.52, 0.4],
+            [0.66, 0.1],
+            [0.96, 0.2],
+            [1.26, 0.3],
+            [1.55, 0.4],
         ];
-        assert_footholds(&p, &[&SHORT_STEPS[..], &on, &[[1.64, 0.4]]].concat());
+        assert_footholds(&p, &[&SHORT_STEPS[..], &on, &[[1.67, 0.4]]].concat());
     }
 
     #[test]
@@ -553,11 +578,31 @@ mod tests {
         let mut p = flat_walk(&[0.12, 0.24, 0.4, 0.48, 0.6, 0.72]);
         place_on_terrain(&mut p, &stairs(), &SOLE, 0.25);
         // The left foot, stalled at the floor's edge (0.37) beside the right, would go on to
-        // tread-1 (0.645), 0.405 m from 0.24: it comes up to the edge instead. The right,
-        // already there, goes on (0.275 m, the shortest step onto the tread), and the left
+        // tread-1 (0.66), 0.42 m from 0.24: it comes up to the edge instead. The right,
+        // already there, goes on (0.29 m, the shortest step onto the tread), and the left
         // joins it.
-        let on = [[0.37, 0.0], [0.37, 0.0], [0.645, 0.1], [0.645, 0.1]];
+        let on = [[0.37, 0.0], [0.37, 0.0], [0.66, 0.1], [0.66, 0.1]];
         assert_footholds(&p, &[&SHORT_STEPS[..], &on].concat());
+    }
+
+    #[test]
+    fn the_step_limit_holds_in_space_down_a_stair() {
+        // A 0.15 m drop at x = 0.5 onto a floor whose fit interval starts at 0.65.
+        let drop = Environment {
+            surfaces: vec![
+                block("landing", -1.0, 0.5, 0.15),
+                block("floor", 0.5, 3.0, 0.0),
+            ],
+            hand_affordances: Vec::new(),
+        };
+        let mut p = flat_walk(&[0.2, 0.37, 0.9]);
+        place_on_terrain(&mut p, &drop, &SOLE, 0.48);
+        // The right foot's 0.48 m step from 0.2 would be 0.503 m in space: it lands
+        // √(0.48² − 0.15²) = 0.456 m along instead, on the floor.
+        let found = footholds(&p);
+        let [x, z] = found[found.len() - 1];
+        let along = (0.48f64.powi(2) - 0.15f64.powi(2)).sqrt();
+        assert!((x - (0.2 + along)).abs() < 1e-12 && z == 0.0, "{found:?}");
     }
 
     #[test]
@@ -568,7 +613,7 @@ mod tests {
         // the middle of its fit interval.
         let right = p.pose(p.len() - 1, RightFoot).translation.vector;
         assert!(
-            (right.x - 0.645).abs() < 1e-12 && (right.z - 0.1).abs() < 1e-12,
+            (right.x - 0.66).abs() < 1e-12 && (right.z - 0.1).abs() < 1e-12,
             "{right:?}"
         );
     }
