@@ -287,6 +287,29 @@ impl Footholds<'_> {
     }
 }
 
+impl Footholds<'_> {
+    /// A landing of foot `f` fitted to surface `k` at `fitted`, beyond the step limit (the
+    /// surface's fit interval starts further than the foot reaches, as past the gap between
+    /// two fit intervals at a ramp's top), while the foot can still come up to the edge of the
+    /// surface it stands on: that edge and surface (the foot goes on from there next time).
+    fn short_of(
+        &self,
+        f: usize,
+        k: usize,
+        fitted: f64,
+        along: f64,
+        lateral: f64,
+        sole: &Isometry3<f64>,
+    ) -> Option<(f64, usize)> {
+        let (own, from) = (self.surface[f]?, self.along[f]?);
+        if own == k || fitted <= self.farthest(f, k, lateral) {
+            return None;
+        }
+        let edge = self.fit(own, along, sole);
+        (edge > from + EDGE_REACHED_M).then_some((edge, own))
+    }
+}
+
 impl LandingRule for Footholds<'_> {
     type Placed = Option<usize>;
 
@@ -301,12 +324,16 @@ impl LandingRule for Footholds<'_> {
         };
         let along = along.min(self.farthest(f, extent.surface, lateral));
         let fitted = self.fit(extent.surface, along, sole);
+        if let Some((edge, own)) = self.short_of(f, extent.surface, fitted, along, lateral, sole) {
+            return (edge - flat, Some(own));
+        }
         // Clamped back by more than half its advance on the other foot, on the surface that
         // foot stands on, the walk would stall at the edge (each landing again short of it):
-        // on to the next surface instead (which rule (i) allows) — unless it is a tread that
-        // far ahead of this foot that the step would be longer than `s_max`, and this foot can
-        // still come up to the edge: it does, and goes on from there next time (onto the first
-        // stair, JVRC-1's static steps reached 0.37 m where its s_max is 0.24 m).
+        // on to the next surface instead (which rule (i) allows) — unless that is so far ahead
+        // of this foot that the step would be longer than `s_max`, and this foot can still come
+        // up to the edge: it does, and goes on from there next time (onto the first stair,
+        // JVRC-1's static steps reached 0.37 m where its s_max is 0.24 m; from a ramp's top on
+        // to its landing, dynamic steps 0.64 m where it is 0.48 m).
         let stalled = !beside
             && self.surface[1 - f] == Some(extent.surface)
             && self.along[1 - f]
@@ -316,11 +343,7 @@ impl LandingRule for Footholds<'_> {
             .next(&extent, lateral)
             .filter(|_| stalled)
             .map(|next| (self.fit(next.surface, along, sole), next))
-            .filter(|(at, next)| {
-                at_the_edge
-                    || !self.is_short(next)
-                    || *at <= self.farthest(f, next.surface, lateral)
-            });
+            .filter(|(at, next)| at_the_edge || *at <= self.farthest(f, next.surface, lateral));
         match onward {
             Some((at, next)) => (at - flat, Some(next.surface)),
             None => (fitted - flat, Some(extent.surface)),
@@ -543,16 +566,16 @@ mod tests {
     fn a_step_limit_shorter_than_two_treads_puts_both_feet_on_each_stair() {
         let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
         place_on_terrain(&mut p, &stairs(), &SOLE, 0.4);
-        // The right foot goes up to tread-1 (the middle of its fit interval, 0.66); the left,
-        // 0.59 m on to tread-2 from the floor's 0.37 with one foot per stair, joins it on
-        // tread-1 instead, beside it, not stalled; the right leads on, one tread (0.30 m) per
-        // step.
+        // The right foot, 0.46 m from tread-1's middle (0.66), first comes up to the floor's
+        // edge (0.37) beside the left; the left goes up to tread-1 (0.29 m); the right, 0.59 m
+        // on to tread-2 with one foot per stair, joins it on tread-1 instead, beside it, not
+        // stalled; the left leads on, one tread (0.30 m) per step.
         let up = [
+            [0.37, 0.0],
             [0.66, 0.1],
             [0.66, 0.1],
             [0.96, 0.2],
             [0.96, 0.2],
-            [1.26, 0.3],
         ];
         assert_footholds(&p, &[&TO_THE_FLOOR_EDGE[..], &up].concat());
     }
@@ -603,6 +626,38 @@ mod tests {
         let [x, z] = found[found.len() - 1];
         let along = (0.48f64.powi(2) - 0.15f64.powi(2)).sqrt();
         assert!((x - (0.2 + along)).abs() < 1e-12 && z == 0.0, "{found:?}");
+    }
+
+    /// A floor to x = 1.0 (its fit interval ends at 0.87) and a long platform 0.05 m up (its
+    /// interval starts at 1.15), as a ramp's top meets its landing.
+    fn platform() -> Environment {
+        Environment {
+            surfaces: vec![
+                block("floor", -1.0, 1.0, 0.0),
+                block("platform", 1.0, 3.0, 0.05),
+            ],
+            hand_affordances: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_landing_its_surface_takes_past_s_max_comes_up_to_the_edge_first() {
+        let mut p = flat_walk(&[0.2, 0.4, 0.6, 0.75, 1.05]);
+        place_on_terrain(&mut p, &platform(), &SOLE, 0.48);
+        // The right foot's landing at 1.05 is on the platform, whose fit interval starts 0.55 m
+        // from the foot's 0.6: it comes up to the floor's edge instead.
+        let found = footholds(&p);
+        assert_eq!(found[found.len() - 1], [0.87, 0.0], "{found:?}");
+    }
+
+    #[test]
+    fn a_stalled_landing_goes_on_to_a_long_surface_only_within_s_max() {
+        let mut p = flat_walk(&[0.1, 0.2, 0.35, 0.55, 0.8, 1.0]);
+        place_on_terrain(&mut p, &platform(), &SOLE, 0.48);
+        // The left foot's landing at 1.0 is clamped back to 0.87, stalled beside the right
+        // foot (0.8): on to the platform would be 0.60 m from 0.55, so it comes up to the edge.
+        let found = footholds(&p);
+        assert_eq!(found[found.len() - 1], [0.87, 0.0], "{found:?}");
     }
 
     #[test]
