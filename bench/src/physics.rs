@@ -328,19 +328,26 @@ pub fn walk_sequence(
     let max_ticks = (time_limit * options.rate_hz).ceil() as u64;
     let settle_ticks = (options.settle_s * options.rate_hz).ceil() as u64;
     let start_midpoint = feet_midpoint(&closed.sim);
+    // The controller's world is the scene's start (identity on the flat floor): the targets are
+    // aligned there, with the standing soles at its z = 0, as the controller aligns the
+    // sequence, then mapped into the simulator's world (as `walkctl evaluate` maps them).
+    let controller_frame = options
+        .scene
+        .as_ref()
+        .map_or_else(Isometry3::identity, |scene| scene.start);
     align_targets(
         &mut targets,
         sequence,
-        &FEET.map(|f| closed.sim.end_effector_pose(f)),
+        &FEET.map(|f| controller_frame.inverse() * closed.sim.end_effector_pose(f)),
     );
+    for target in &mut targets {
+        *target = target.transformed(&controller_frame);
+    }
     let mut loop_state = LoopState {
         trace: Vec::with_capacity((max_ticks / options.trace_every.max(1)).min(1 << 20) as usize),
         max_com_drift: 0.0,
         max_foot_drift: 0.0,
-        controller_frame: options
-            .scene
-            .as_ref()
-            .map_or_else(Isometry3::identity, |scene| scene.start),
+        controller_frame,
         max_tilt: 0.0,
         controller_time: Duration::ZERO,
         physics_time: Duration::ZERO,

@@ -415,3 +415,60 @@ fn a_released_hand_is_carried_with_the_pelvis_only_when_configured() {
         }
     }
 }
+
+/// The heading about the vertical of a status pose `[x, y, z, qx, qy, qz, qw]` (rad).
+fn heading_of(pose: &[f64; 7]) -> f64 {
+    let rotation = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+        pose[6], pose[3], pose[4], pose[5],
+    ));
+    let x = rotation * nalgebra::Vector3::x();
+    x.y.atan2(x.x)
+}
+
+#[test]
+fn the_estimate_turns_onto_the_imu_heading_no_faster_than_its_bound() {
+    // The feet turned together on the ground by `turn`: leg odometry cannot see it, the IMU
+    // does. The estimate (and the anchored feet with it) follows the IMU at
+    // `heading_correction_speed`, or not at all at 0.
+    let turn = 0.02;
+    for speed in [0.0, 0.05] {
+        let config = ControllerConfig {
+            heading_correction_speed: speed,
+            ..walk_support::controller_config("jvrc1")
+        };
+        let mut h = walk_support::Harness::with_config("jvrc1", config, RATE_HZ);
+        h.tick();
+        let m = h.closed.sim.measurement().clone();
+        let imu = nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, turn) * m.base_orientation;
+        let measurement = daemon::controller::Measurement {
+            q: m.q.as_slice(),
+            qd: m.qd.as_slice(),
+            wrenches: &m.wrenches,
+            imu_orientation: Some(imu),
+        };
+        let start = heading_of(&h.closed.controller.status().left_foot);
+        let mut previous = start;
+        // Twice the time the bounded speed needs.
+        let ticks = (2.0 * turn / 0.05 / h.dt).ceil() as usize;
+        for _ in 0..ticks {
+            let _ = h
+                .closed
+                .controller
+                .tick(&measurement, h.dt, &mut h.closed.command);
+            let now = heading_of(&h.closed.controller.status().left_foot);
+            assert!(
+                (now - previous).abs() <= speed * h.dt + 1e-9,
+                "speed {speed}: turned {} rad in one tick",
+                now - previous
+            );
+            previous = now;
+        }
+        let expected = if speed > 0.0 { turn } else { 0.0 };
+        assert!(
+            (previous - start - expected).abs() < 1e-6,
+            "speed {speed}: the left foot's estimated heading turned {} rad, not {expected}",
+            previous - start
+        );
+        assert_eq!(h.closed.controller.status().state, ControllerState::Idle);
+    }
+}

@@ -118,6 +118,12 @@ pub struct ControllerConfig {
     /// count): the stance feet are no longer flat on the ground. Only checked when the
     /// measurement has an IMU.
     pub tipping_detection_rad: f64,
+    /// How fast leg odometry's heading is turned onto the IMU's (rad/s; 0: leg odometry alone).
+    /// Odometry cannot see the feet turning together on the ground (down a stair, a touchdown
+    /// turns both by up to 0.01 rad, always the same way when the same foot leads), and the walk
+    /// curves off its footholds. Only the yaw is taken from the IMU: its tilt would fight the
+    /// anchored feet (docs/controller.md, "Floating base").
+    pub heading_correction_speed: f64,
     /// Whether a hand that lets go is carried along with the pelvis, as it held, until its next
     /// reach, instead of being left to the posture task. Returning to the posture at once
     /// twists the torso back abruptly (JVRC-1 turns its waist ~0.3 rad to hold a railing), which
@@ -189,6 +195,7 @@ impl Default for ControllerConfig {
             command_lead_max_rad: 0.05,
             unload_foot_weight: 100.0,
             tipping_detection_rad: 0.25,
+            heading_correction_speed: 0.05,
             carry_released_hands: false,
             joint_limit_tolerance_rad: 0.03,
             workspace_radius_m: 100.0,
@@ -372,6 +379,12 @@ impl ControllerConfig {
                 self.tipping_detection_rad,
                 0.01,
                 1.5,
+            ),
+            Bound::new(
+                "heading_correction_speed",
+                self.heading_correction_speed,
+                0.0,
+                10.0,
             ),
             Bound::new(
                 "joint_limit_tolerance_rad",

@@ -1,8 +1,10 @@
 //! Floating-base estimation by leg odometry: the feet in contact are anchored in the world, so the
 //! base pose follows from the measured joint angles.
 //!
-//! An IMU, when present, sets the initial orientation only. While walking the orientation comes
-//! from the anchored feet too: the QP holds those feet at their anchors, and an estimate that saw
+//! An IMU, when present, sets the initial orientation and, after that, the heading only: the
+//! controller turns the world anchors about the vertical so the estimate's yaw follows the IMU's
+//! ([`BaseEstimator::heading_error`]), which catches the feet turning together on the ground,
+//! the one motion leg odometry cannot see. Roll and pitch come from the anchored feet: the QP holds those feet at their anchors, and an estimate that saw
 //! a stance foot tipped (the IMU's view when a compliant foot rolls a little on its edge) would
 //! make the anchor correction turn the joints to flatten the foot, which rolls the robot further
 //! the same way. Measured under MuJoCo: with the IMU orientation JVRC-1 toppled in 3 of 3 5 m
@@ -58,6 +60,13 @@ impl BaseEstimator {
         lowest.map(|z| z - ground <= STANDING_TOLERANCE)
     }
 
+    /// The turn about the vertical (rad, in [−π, π]) that brings the last estimate's heading onto
+    /// the IMU's base orientation `imu`. The world's yaw is the IMU's since [`Self::initialise`].
+    pub fn heading_error(&self, imu: &UnitQuaternion<f64>) -> f64 {
+        let turn = heading(imu) - heading(&self.base.rotation);
+        turn.sin().atan2(turn.cos())
+    }
+
     /// Estimates the base from the anchored feet (`anchors[i]` for left/right foot, weighted by
     /// `weights`) and updates `kinematics` at the estimate. Returns `false` when no foot is
     /// anchored (the base is then kept).
@@ -104,5 +113,38 @@ impl BaseEstimator {
         configuration.base = self.base;
         kinematics.update(&robot.model, configuration);
         true
+    }
+}
+
+/// The direction of `rotation`'s x axis about the world vertical (rad).
+fn heading(rotation: &UnitQuaternion<f64>) -> f64 {
+    let x = rotation * Vector3::x();
+    x.y.atan2(x.x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn turned(yaw: f64) -> UnitQuaternion<f64> {
+        // Tilted too: only the heading about the vertical counts.
+        UnitQuaternion::from_euler_angles(0.0, 0.0, yaw)
+            * UnitQuaternion::from_euler_angles(0.1, -0.2, 0.0)
+    }
+
+    #[test]
+    fn the_heading_error_is_the_shorter_turn_about_the_vertical() {
+        let estimator = BaseEstimator::new(Isometry3::from_parts(
+            Translation3::new(1.0, 2.0, 0.8),
+            turned(3.1),
+        ));
+        // Across ±π the shorter way round, not −6.2 rad.
+        let across = estimator.heading_error(&turned(-3.1));
+        assert!(
+            (across - (2.0 * std::f64::consts::PI - 6.2)).abs() < 1e-9,
+            "{across}"
+        );
+        let small = estimator.heading_error(&turned(3.05));
+        assert!((small + 0.05).abs() < 1e-9, "{small}");
     }
 }

@@ -63,6 +63,14 @@ pub(crate) struct Targets {
 }
 
 impl Targets {
+    /// Moves every anchor by `motion` (a turn of the world the anchors are held in: the
+    /// estimate's heading correction, which moves nothing on the robot).
+    pub fn move_anchors(&mut self, motion: &Isometry3<f64>) {
+        for anchor in &mut self.anchors {
+            *anchor = motion * *anchor;
+        }
+    }
+
     /// World anchors of the feet in contact, for the estimator.
     pub fn foot_anchors(&self) -> [Option<&Isometry3<f64>>; 2] {
         FEET.map(|f| {
@@ -241,6 +249,11 @@ impl StateMachine {
     /// The live contact set and anchors (also used for estimation while holding).
     pub fn targets(&self) -> &Targets {
         &self.targets
+    }
+
+    /// The live targets, to turn their anchors with the estimate's heading.
+    pub fn targets_mut(&mut self) -> &mut Targets {
+        &mut self.targets
     }
 
     /// The posture reference of the stance being moved towards.

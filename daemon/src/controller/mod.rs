@@ -52,7 +52,7 @@ use std::sync::Arc;
 use kinematics::configuration::Configuration;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
-use nalgebra::{DVector, Isometry3, UnitQuaternion};
+use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
 
 pub use config::{ConfigError, ControllerConfig};
 pub use gait::{DynamicGaitConfig, GaitConfig, StabilizerConfig};
@@ -516,6 +516,9 @@ impl Controller {
         if !self.world_ready {
             self.initialise_world(measurement);
         }
+        if measured {
+            self.correct_heading(measurement.imu_orientation, dt);
+        }
         if !self.estimate(measurement, measured) {
             self.enter_fault(FaultCode::LostSupport);
             return self.write_hold(out);
@@ -733,6 +736,26 @@ impl Controller {
             *command = q.clamp(limit.lower, limit.upper);
         }
         self.world_ready = true;
+    }
+
+    /// Turns the world the anchors are held in about the vertical through the CoM, by at most
+    /// `heading_correction_speed · dt`, towards the IMU's heading (`BaseEstimator::heading_error`).
+    /// The base estimate turns with the anchors, so no joint moves; what changes is where the
+    /// plan's world targets lie from the robot, so the next footholds are found again.
+    fn correct_heading(&mut self, imu: Option<UnitQuaternion<f64>>, dt: f64) {
+        let Some(imu) = imu else {
+            return;
+        };
+        let most = self.config.heading_correction_speed * dt;
+        let turn = self.estimator.heading_error(&imu).clamp(-most, most);
+        if turn == 0.0 {
+            return;
+        }
+        let com = self.kinematics.com();
+        let pivot = Translation3::new(com.x, com.y, 0.0);
+        let rotation = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), turn);
+        self.machine
+            .move_anchors(&(pivot * rotation * pivot.inverse()));
     }
 
     /// Leg odometry, the anchored feet weighted by their measured load (equally when the

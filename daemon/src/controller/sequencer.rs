@@ -104,6 +104,17 @@ impl Sequencer {
         }
     }
 
+    /// Moves the live anchors by `motion`, a turn of the world they are held in (the
+    /// estimate's heading correction).
+    pub fn move_anchors(&mut self, motion: &Isometry3<f64>) {
+        let targets = if self.dynamic.started() {
+            self.dynamic.targets_mut()
+        } else {
+            self.fallback.targets_mut()
+        };
+        targets.move_anchors(motion);
+    }
+
     /// World anchors of the feet in contact, for the estimator.
     pub fn foot_anchors(&self) -> [Option<&Isometry3<f64>>; 2] {
         self.targets().foot_anchors()

@@ -261,6 +261,11 @@ impl DynamicWalker {
         &self.targets
     }
 
+    /// The live targets, to turn their anchors with the estimate's heading.
+    pub fn targets_mut(&mut self) -> &mut Targets {
+        &mut self.targets
+    }
+
     /// The balance readings of the last update.
     pub fn balance(&self) -> &BalanceStatus {
         &self.balance
