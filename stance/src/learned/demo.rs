@@ -6,7 +6,7 @@
 //! [[trial]]
 //! file = "treadmill_events.c3d"
 //! format = "c3d"          # c3d | gaitkit-json | npy-mocap53
-//! forward = "-y"          # capture axis the subject walks along
+//! forward = "-y"          # capture axis the subject walks along (checked)
 //! up = "+z"
 //! belt_speed = 1.105      # optional, treadmill trials: unrolled so stance feet stand still
 //! rate = 120.0            # required for npy (the file carries none)
@@ -20,6 +20,7 @@ use serde::Deserialize;
 use super::c3d::C3dFile;
 use super::error::LearnError;
 use super::npy;
+use super::validate::validate;
 
 /// Annotated gait event kinds (C3D EVENT group).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,7 +78,9 @@ pub struct TrialEntry {
     pub file: PathBuf,
     /// `c3d`, `gaitkit-json` or `npy-mocap53`.
     pub format: String,
-    /// Capture axis of walking: `+x`, `-x`, `+y`, `-y`, `+z`, `-z`.
+    /// Capture axis of walking: `+x`, `-x`, `+y`, `-y`, `+z`, `-z`. Everything learned is
+    /// relative to the pelvis heading, so this only orients the trial; it is checked against the
+    /// direction the subject actually walks, and a treadmill belt is unrolled along it.
     pub forward: String,
     /// Capture axis pointing up.
     pub up: String,
@@ -113,7 +116,9 @@ pub fn load_folder(dir: &Path) -> Result<Vec<Demonstration>, LearnError> {
         .collect()
 }
 
-/// Loads one trial file as described by its manifest entry.
+/// Loads one trial file as described by its manifest entry and refuses it
+/// ([`LearnError::BadTrial`]) unless it looks like a human walking along the declared `forward`
+/// (checks in `learned/validate.rs`, listed in `docs/learning.md`).
 pub fn load_trial(path: &Path, entry: &TrialEntry) -> Result<Demonstration, LearnError> {
     let axes = Axes::new(&entry.forward, &entry.up).map_err(|message| LearnError::Manifest {
         path: path.to_path_buf(),
@@ -139,11 +144,16 @@ pub fn load_trial(path: &Path, entry: &TrialEntry) -> Result<Demonstration, Lear
     if let Some(speed) = entry.belt_speed {
         unroll_belt(&mut demo, speed);
     }
+    validate(&demo, &axes).map_err(|reason| LearnError::BadTrial {
+        path: path.to_path_buf(),
+        trial: demo.name.clone(),
+        reason,
+    })?;
     Ok(demo)
 }
 
 /// Capture axes → canonical (forward, left, up).
-struct Axes {
+pub(super) struct Axes {
     forward: Vector3<f64>,
     up: Vector3<f64>,
 }
@@ -176,6 +186,29 @@ impl Axes {
         let left = self.up.cross(&self.forward);
         Vector3::new(p.dot(&self.forward), p.dot(&left), p.dot(&self.up))
     }
+
+    /// The declared forward axis as written in `demo.toml` (`+x`, `-y`, …), for messages.
+    pub(super) fn forward_name(&self) -> String {
+        axis_name(&self.forward)
+    }
+
+    /// The declared up axis as written in `demo.toml`, for messages.
+    pub(super) fn up_name(&self) -> String {
+        axis_name(&self.up)
+    }
+
+    /// The capture axis nearest to the canonical direction `direction`, for messages.
+    pub(super) fn capture_axis_name(&self, direction: &Vector3<f64>) -> String {
+        let left = self.up.cross(&self.forward);
+        axis_name(&(self.forward * direction.x + left * direction.y + self.up * direction.z))
+    }
+}
+
+/// The name (`+x`, `-y`, …) of the coordinate axis nearest to `v`.
+fn axis_name(v: &Vector3<f64>) -> String {
+    let k = v.iamax();
+    let sign = if v[k] < 0.0 { '-' } else { '+' };
+    format!("{sign}{}", ['x', 'y', 'z'][k])
 }
 
 /// Adds the belt travel so that a foot standing on the belt stands still.

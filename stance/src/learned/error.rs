@@ -42,6 +42,15 @@ pub enum LearnError {
         marker: String,
         frame: usize,
     },
+    /// A trial loaded but is not a plausible human walk (wrong axes or units, wrong `forward`,
+    /// no data, no steps, no progress): refused at load time, naming the reason, rather than
+    /// training a model that fails later with an error that says nothing about the trial.
+    #[error("{path}: refused trial `{trial}`: {reason}")]
+    BadTrial {
+        path: PathBuf,
+        trial: String,
+        reason: String,
+    },
     /// The `demo.toml` manifest of a demonstration folder is invalid.
     #[error("{path}: {message}")]
     Manifest { path: PathBuf, message: String },

@@ -1,5 +1,6 @@
 //! Stance sequences learned from real human demonstrations (issue 7; the paper's stance source):
-//! readers for motion-capture files ([`c3d`], [`npy`], gaitkit JSON in [`demo`]), segmentation
+//! readers for motion-capture files ([`c3d`], [`npy`], gaitkit JSON in [`demo`]) that refuse
+//! implausible trials at load time (`validate`: wrong axes or `forward`, no steps), segmentation
 //! into stances with taxonomy labels ([`mod@segment`]), an n-gram model over stance tokens
 //! ([`model`]) with a hand-support part ([`hands`]), its query by distance and affordances
 //! ([`query`]), retargeting of the generated stances to a robot ([`retarget`]), realism
@@ -19,6 +20,7 @@ pub mod realism;
 pub mod retarget;
 pub mod segment;
 pub mod source;
+mod validate;
 
 pub use demo::{Demonstration, EventKind, GaitEvent, load_folder};
 pub use error::LearnError;
