@@ -2,16 +2,12 @@
 //! `demo.toml` manifest) and write it as JSON; optionally report realism against a held-out
 //! folder.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::builder::RangedU64ValueParser;
 use kinematics::bounds::Range;
-use stance::learned::realism::{WalkStatistics, of_generated, of_keyframes};
-use stance::learned::{
-    NgramModel, Query, Search, SegmentOptions, TrainOptions, generate_tokens, load_folder, segment,
-    taxonomy_label,
-};
+use stance::learned::{NgramModel, TrainOptions, load_folder, segment, taxonomy_label};
 
 /// Arguments of `walkctl learn`.
 #[derive(Debug, Clone, clap::Args)]
@@ -34,8 +30,8 @@ pub struct LearnArgs {
     /// Do not add left-right mirrored copies of the demonstrations.
     #[arg(long)]
     pub no_mirror: bool,
-    /// A held-out demonstration folder: print step length, step width and stance duration of
-    /// generated sequences against it.
+    /// A held-out demonstration folder: print the realism table of generated sequences against
+    /// it (as `walkctl realism` does).
     #[arg(long, value_name = "DIR")]
     pub holdout: Option<PathBuf>,
 }
@@ -85,41 +81,7 @@ pub fn run(args: &LearnArgs) -> anyhow::Result<()> {
         model.human_pelvis_height
     );
     if let Some(dir) = &args.holdout {
-        print_realism(&model, dir)?;
+        crate::realism::print_comparison(&model, dir)?;
     }
     Ok(())
-}
-
-/// Prints the realism report: the held-out trials against the most probable and ten sampled
-/// 10 m sequences (human scale).
-fn print_realism(model: &NgramModel, dir: &Path) -> anyhow::Result<()> {
-    let held_out = load_folder(dir)?;
-    for demo in &held_out {
-        let keyframes = segment(demo, &SegmentOptions::default()).keyframes;
-        print_statistics(
-            &format!("held-out {}", demo.name),
-            &of_keyframes(&keyframes),
-        );
-    }
-    let query = |search| Query {
-        distance: 10.0,
-        hands: [Vec::new(), Vec::new()],
-        search,
-    };
-    let beam = generate_tokens(model, &query(Search::Beam(8)))?;
-    print_statistics("generated, beam search", &of_generated(model, &beam));
-    let mut pooled = generate_tokens(model, &query(Search::Sample(0)))?;
-    for seed in 1..10 {
-        let generated = generate_tokens(model, &query(Search::Sample(seed)))?;
-        pooled.tokens.extend(generated.tokens);
-    }
-    print_statistics("generated, 10 samples", &of_generated(model, &pooled));
-    Ok(())
-}
-
-fn print_statistics(name: &str, statistics: &WalkStatistics) {
-    println!("{name}");
-    println!("  step length [m]     {}", statistics.step_length);
-    println!("  step width [m]      {}", statistics.step_width);
-    println!("  stance duration [s] {}", statistics.stance_duration);
 }

@@ -19,6 +19,7 @@ pub mod learn;
 pub mod observe;
 pub mod postprocess;
 pub mod process;
+pub mod realism;
 pub mod status;
 pub mod submit;
 pub mod watch;

@@ -27,6 +27,8 @@ enum Command {
     BenchPostprocess(client::bench_postprocess::BenchPostprocessArgs),
     /// Train the n-gram stance model on human demonstrations.
     Learn(client::learn::LearnArgs),
+    /// Compare a trained model's generated walks with a held-out human walker (gait measures).
+    Realism(client::realism::RealismArgs),
     /// Fig. 4: covered vs requested distance of learned, post-processed walks.
     BenchCoverage(client::bench_coverage::BenchCoverageArgs),
     /// Submit a stance sequence to a running walkd (post-processing it first with --postprocess).
@@ -67,6 +69,7 @@ fn main() -> std::process::ExitCode {
         Command::Postprocess(args) => client::postprocess::run(args),
         Command::BenchPostprocess(args) => client::bench_postprocess::run(args),
         Command::Learn(args) => client::learn::run(args),
+        Command::Realism(args) => client::realism::run(args),
         Command::BenchCoverage(args) => client::bench_coverage::run(args),
     };
     match result {

@@ -4,7 +4,7 @@
 //! into stances with taxonomy labels ([`mod@segment`]), an n-gram model over stance tokens
 //! ([`model`]) with a hand-support part ([`hands`]), its query by distance and affordances
 //! ([`query`]), retargeting of the generated stances to a robot ([`retarget`]), realism
-//! statistics ([`realism`]), the paper's Fig. 4 ([`coverage`]) and the source choice shared by
+//! against a held-out walker ([`realism`]), the paper's Fig. 4 ([`coverage`]) and the source choice shared by
 //! the commands that generate ([`source`]). See `docs/learning.md`.
 
 pub mod c3d;
@@ -26,7 +26,7 @@ pub use demo::{Demonstration, EventKind, GaitEvent, load_folder};
 pub use error::LearnError;
 pub use model::{NgramModel, TrainOptions};
 pub use query::{Generated, Query, Search, generate_tokens};
-pub use realism::{Distribution, WalkStatistics};
+pub use realism::{Comparison, Distribution, Measure, WalkStatistics};
 pub use retarget::{LearnedOptions, Retargeted, generate_learned};
 pub use segment::{Keyframe, SegmentOptions, Segmentation, foot_events, segment, taxonomy_label};
 pub use source::{SourceArgs, SourceError, SourceKind, Sourced, StanceSource};

@@ -120,12 +120,19 @@ fn foot_heights(demo: &Demonstration, k: usize) -> impl Iterator<Item = f64> {
     demo.feet.iter().flat_map(move |foot| foot[k].map(|p| p.z))
 }
 
-fn pelvis_height(demo: &Demonstration, axes: &Axes) -> Result<(), String> {
+/// The median over the frames of the pelvis's height above the lowest heel or toe point (m): the
+/// walker's size, checked here against the human range and used as the leg length that
+/// normalises the realism measures ([`super::realism`]).
+pub(crate) fn pelvis_height_above_feet(demo: &Demonstration) -> f64 {
     let mut heights: Vec<f64> = (0..demo.len())
         .map(|k| demo.pelvis[k].z - foot_heights(demo, k).fold(f64::INFINITY, f64::min))
         .collect();
     heights.sort_by(f64::total_cmp);
-    let median = heights[heights.len() / 2];
+    heights[heights.len() / 2]
+}
+
+fn pelvis_height(demo: &Demonstration, axes: &Axes) -> Result<(), String> {
+    let median = pelvis_height_above_feet(demo);
     let [low, high] = PELVIS_HEIGHT_M;
     if !(low..=high).contains(&median) {
         return Err(format!(
