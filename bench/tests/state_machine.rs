@@ -418,11 +418,9 @@ fn a_released_hand_is_carried_with_the_pelvis_only_when_configured() {
 
 /// The heading about the vertical of a status pose `[x, y, z, qx, qy, qz, qw]` (rad).
 fn heading_of(pose: &[f64; 7]) -> f64 {
-    let rotation = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
-        pose[6], pose[3], pose[4], pose[5],
-    ));
-    let x = rotation * nalgebra::Vector3::x();
-    x.y.atan2(x.x)
+    kinematics::ground::yaw(&nalgebra::UnitQuaternion::from_quaternion(
+        nalgebra::Quaternion::new(pose[6], pose[3], pose[4], pose[5]),
+    ))
 }
 
 #[test]

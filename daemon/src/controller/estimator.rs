@@ -4,8 +4,8 @@
 //! An IMU, when present, sets the initial orientation and, after that, the heading only: the
 //! controller turns the world anchors about the vertical so the estimate's yaw follows the IMU's
 //! ([`BaseEstimator::heading_error`]), which catches the feet turning together on the ground,
-//! the one motion leg odometry cannot see. Roll and pitch come from the anchored feet: the QP holds those feet at their anchors, and an estimate that saw
-//! a stance foot tipped (the IMU's view when a compliant foot rolls a little on its edge) would
+//! the one motion leg odometry cannot see. Roll and pitch come from the anchored feet: the QP
+//! holds those feet at their anchors, and an estimate that saw a stance foot tipped (the IMU's view when a compliant foot rolls a little on its edge) would
 //! make the anchor correction turn the joints to flatten the foot, which rolls the robot further
 //! the same way. Measured under MuJoCo: with the IMU orientation JVRC-1 toppled in 3 of 3 5 m
 //! walks, with leg odometry alone it finished all three.
@@ -15,7 +15,7 @@ use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-use kinematics::ground::sole_corners;
+use kinematics::ground::{sole_corners, yaw};
 
 /// Feet closer than this to the lowest sole when the world frame is set up count as standing (m).
 const STANDING_TOLERANCE: f64 = 2e-3;
@@ -63,7 +63,7 @@ impl BaseEstimator {
     /// The turn about the vertical (rad, in [−π, π]) that brings the last estimate's heading onto
     /// the IMU's base orientation `imu`. The world's yaw is the IMU's since [`Self::initialise`].
     pub fn heading_error(&self, imu: &UnitQuaternion<f64>) -> f64 {
-        let turn = heading(imu) - heading(&self.base.rotation);
+        let turn = yaw(imu) - yaw(&self.base.rotation);
         turn.sin().atan2(turn.cos())
     }
 
@@ -114,12 +114,6 @@ impl BaseEstimator {
         kinematics.update(&robot.model, configuration);
         true
     }
-}
-
-/// The direction of `rotation`'s x axis about the world vertical (rad).
-fn heading(rotation: &UnitQuaternion<f64>) -> f64 {
-    let x = rotation * Vector3::x();
-    x.y.atan2(x.x)
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@
 //! Stances cut by the start or end of a recording never make a step. See `docs/learning.md`
 //! ("Realism against the held-out walker") for the definitions.
 
+use kinematics::ground::GRAVITY as G;
 use nalgebra::{Vector2, Vector3};
 
 use super::demo::{Demonstration, EventKind};
@@ -16,9 +17,6 @@ use super::model::NgramModel;
 use super::query::{Generated, Query, Search, generate_tokens};
 use super::segment::{SegmentOptions, foot_events, segment};
 use super::validate::pelvis_height_above_feet;
-
-/// Gravity (m/s²) of the Froude (leg-length) normalisation.
-const G: f64 = 9.81;
 
 /// Human-scale distance (m) of each generated sequence the comparison measures.
 const GENERATED_DISTANCE_M: f64 = 10.0;
