@@ -33,7 +33,7 @@ use sim_adapter::MotorLoad;
 use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim, Terrain};
 use stance::poses::FEET;
 use stance::{
-    PostProcessParams, PostProcessedSequence, Scene, WalkRequest, generate, synthetic_walk, walk_on,
+    PostProcessParams, PostProcessedSequence, Scene, WalkRequest, generate, synthetic_walk, walk_in,
 };
 
 use crate::closed_loop::{ClosedLoop, TickError, feet_midpoint};
@@ -251,8 +251,8 @@ impl PhysicsWalkReport {
 }
 
 /// Generates the walk of `request` for the robot of `config`, post-processes it with the
-/// parameters of `options.gait` (onto `options.scene`'s surfaces, if any) and walks it under
-/// physics.
+/// parameters of `options.gait` (onto `options.scene`'s surfaces and railings, if any) and walks
+/// it under physics.
 pub fn walk_distance(
     config: &ConfigFile,
     urdf: Option<&Path>,
@@ -269,11 +269,11 @@ pub fn walk_distance(
         gaits.dynamic = options.dynamic;
     }
     let sequence = match &options.scene {
-        Some(scene) => walk_on(
+        Some(scene) => walk_in(
             &robot,
             &params,
             request,
-            &scene.walk_environment().surfaces,
+            &scene.walk_environment(),
             |options| generate(&robot, options),
         )?,
         None => synthetic_walk(&robot, &params, request)?,

@@ -239,12 +239,11 @@ pub fn scene_walk_sequence(
 ) -> anyhow::Result<stance::PostProcessedSequence> {
     let params = stance::PostProcessParams::from_config_for(file, gait)?;
     let request = WalkRequest::feet(scene.path_length(), seed);
-    let surfaces = scene.walk_environment().surfaces;
-    Ok(stance::walk_on(
+    Ok(stance::walk_in(
         robot,
         &params,
         &request,
-        &surfaces,
+        &scene.walk_environment(),
         |options| stance::generate(robot, options),
     )?)
 }

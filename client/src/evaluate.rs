@@ -27,6 +27,7 @@ pub(crate) mod balance;
 pub mod fig6;
 pub mod filmstrip;
 pub mod footholds;
+pub(crate) mod hands;
 pub mod record;
 pub mod stop;
 pub(crate) mod truth;
@@ -248,6 +249,9 @@ pub struct RunResult {
     pub stop: Option<StopReport>,
     /// Steps, footholds, elevations and terrain collisions from the simulator's truth.
     pub steps: StepReport,
+    /// The held hands' mean vertical force over the robot's weight while a hand is planned in
+    /// contact, from the simulator's contact forces; `None` without a held hand.
+    pub hand_support_share: Option<f64>,
 }
 
 impl RunResult {
@@ -280,6 +284,7 @@ impl RunResult {
             "time_per_step_s": self.steps.time_per_step_s,
             "terrain_collisions": self.steps.terrain_collisions,
             "foothold_error_m": self.steps.foothold_error_m,
+            "hand_support_share": self.hand_support_share,
             "injected": self.stop.map(|stop| serde_json::json!({
                 "fault": stop.injection.fault.name(),
                 "at": stop.injection.moment.name(),
@@ -441,12 +446,13 @@ fn run_once(
         seed: run,
     } = request;
     let sequence = match scene {
-        Some(scene) => {
-            let surfaces = scene.walk_environment().surfaces;
-            stance::walk_on(model, &params, request, &surfaces, |options| {
-                stance::generate(model, options)
-            })?
-        }
+        Some(scene) => stance::walk_in(
+            model,
+            &params,
+            request,
+            &scene.walk_environment(),
+            |options| stance::generate(model, options),
+        )?,
         None => stance::synthetic_walk(model, &params, request)?,
     };
     // One prefix a run: the runs of one walk with different faults follow each other, and a new
@@ -550,6 +556,16 @@ fn run_once(
     );
     let steps = StepReport::of(&walk.states, walk.submitted_ns, walk.sim_s, &planned)
         .context("no simulator truth recorded")?;
+    let contacts: Vec<_> = (0..sequence.len()).map(|i| sequence.contacts(i)).collect();
+    let hand_support_share = hands::support_share(
+        &contacts,
+        walk.trace
+            .iter()
+            .map(|sample| sample.stance_index)
+            .zip(walk.status_times.iter().copied()),
+        &walk.states,
+        model.model.total_mass() * kinematics::ground::GRAVITY,
+    );
     // Through a scene a walk must also land on its footholds (its treads).
     let (success, outcome) = footholds::judged_on_terrain(
         scene.is_some() && stop.is_none(),
@@ -583,13 +599,14 @@ fn run_once(
         balance: walk.balance,
         stop,
         steps,
+        hand_support_share,
     })
 }
 
 fn row(result: &RunResult) -> String {
     let r = &result.record;
     format!(
-        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{} {}{}",
+        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{} {}{}{}",
         result.robot,
         result.gait.name(),
         r.affordances.name(),
@@ -610,6 +627,9 @@ fn row(result: &RunResult) -> String {
         result.stance_reached,
         r.stances,
         describe_steps(&result.steps),
+        result
+            .hand_support_share
+            .map_or_else(String::new, |share| format!(" hand share {share:.3}")),
         r.actuators
             .as_ref()
             .map_or_else(String::new, |a| format!(" {}", a.describe()))
@@ -678,6 +698,19 @@ fn summary(results: &[RunResult]) -> String {
                     "",
                     group.distance_m,
                     actuators.describe()
+                );
+            }
+            let shares: Vec<f64> = runs.iter().filter_map(|r| r.hand_support_share).collect();
+            if !shares.is_empty() {
+                let _ = writeln!(
+                    out,
+                    "{:<8} {:<16} {:>6.1} m  hand support share mean {:.3}, min {:.3}, max {:.3}",
+                    "",
+                    "",
+                    group.distance_m,
+                    shares.iter().sum::<f64>() / shares.len() as f64,
+                    shares.iter().copied().fold(f64::INFINITY, f64::min),
+                    shares.iter().copied().fold(f64::NEG_INFINITY, f64::max)
                 );
             }
         }

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
+use anyhow::{Context, anyhow};
 use kinematics::ConfigFile;
 use kinematics::bounds::Range;
 use stance::learned::SourceArgs;
@@ -26,8 +26,9 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "D", value_parser = DISTANCE_M.parser(), required_unless_present = "scene", conflicts_with = "scene")]
     pub distance: Option<f64>,
     /// Walk through this scene (docs/scenes.md) from its start to its goal: the distance is the
-    /// path's length, and the raw sequence carries the scene's surfaces (in the walk's frame,
-    /// starting at the origin) for `walkctl postprocess` to put the walk onto.
+    /// path's length, and the raw sequence carries the scene's surfaces and railings (in the
+    /// walk's frame, starting at the origin) for `walkctl postprocess` to put the walk and its
+    /// held hands onto. A held hand needs a scene with a railing.
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
     /// Generate exactly D metres (no division by scf).
@@ -99,7 +100,16 @@ pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
         );
     }
     let raw = match &scene {
-        Some(scene) => sourced.raw.on_surfaces(&scene.walk_environment().surfaces),
+        Some(scene) => sourced
+            .raw
+            .in_environment(scene.walk_environment())
+            .map_err(|refusal| {
+                anyhow!(
+                    "scene \"{}\": {refusal}; use --affordances feet or a scene with a \
+                     [[railing]]",
+                    scene.name
+                )
+            })?,
         None => sourced.raw,
     };
     std::fs::write(&args.output, raw.to_json_string())

@@ -13,9 +13,13 @@
 //! left_foot = { link = "L_ANKLE_P_S", translation = [0.03, 0.0, -0.1077], rpy = [0.0, 0.0, 0.0] }
 //! # right_foot, left_hand, right_hand likewise
 //!
+//! palm_radius = 0.04                     # optional, default half the sole width
+//!
 //! [robot.ft_sensors]
 //! left = { link = "lfsensor" }            # translation / rpy default to zero
 //! right = { link = "rfsensor" }
+//! left_hand = { link = "lhsensor" }       # optional wrist sensors; default: the origin of the
+//! right_hand = { link = "rhsensor" }      # link the hand's frame is on (its wrist)
 //!
 //! [robot.joint_groups]
 //! legs = ["R_HIP_P", ...]
@@ -127,6 +131,17 @@ impl JointGroups {
 /// Names of the FT sensor frames added to the model.
 pub const FT_SENSOR_FRAMES: [&str; 2] = ["left_ft_sensor", "right_ft_sensor"];
 
+/// Names of the wrist FT sensor frames added to the model.
+pub const WRIST_FT_SENSOR_FRAMES: [&str; 2] = ["left_wrist_ft_sensor", "right_wrist_ft_sensor"];
+
+/// The palm's radius when the config gives none, as a fraction of the sole width (0.04 m on
+/// JVRC-1, 0.062 m on ARMAR-4; kept within the range of `[robot] palm_radius`): a hand about
+/// as wide as half its foot.
+pub const PALM_RADIUS_PER_SOLE_WIDTH: f64 = 0.5;
+
+/// The range of `[robot] palm_radius` (m).
+const PALM_RADIUS_M: Range = Range::new(0.005, 0.2);
+
 /// A model with its configured frames and standing posture.
 #[derive(Debug, Clone)]
 pub struct Robot {
@@ -145,6 +160,11 @@ pub struct Robot {
     pub sole: SoleRectangle,
     /// FT sensor frames: left foot, right foot.
     pub ft_sensors: [FrameId; 2],
+    /// Wrist FT sensor frames, where a hand's contact wrench is measured: left hand, right hand.
+    pub wrist_ft_sensors: [FrameId; 2],
+    /// Radius (m) of the sphere centred on each hand frame that touches a railing: where a
+    /// grasp puts the hand frame (on top of the rail) and the hand's collision geometry.
+    pub palm_radius: f64,
     /// Joint groups.
     pub joint_groups: JointGroups,
     /// Standing posture: both soles flat on z = 0, their midpoint at x = y = 0.
@@ -241,6 +261,8 @@ struct EndEffectorSpecs {
 struct FtSensorSpecs {
     left: FrameSpec,
     right: FrameSpec,
+    left_hand: Option<FrameSpec>,
+    right_hand: Option<FrameSpec>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -259,6 +281,7 @@ struct RobotSection {
     urdf: Option<PathBuf>,
     base_link: String,
     sole: SoleRectangle,
+    palm_radius: Option<f64>,
     frames: EndEffectorSpecs,
     ft_sensors: FtSensorSpecs,
     joint_groups: JointGroupSpecs,
@@ -375,6 +398,37 @@ impl Loader<'_> {
                 &section.ft_sensors.right,
             )?,
         ];
+        let ft = &section.ft_sensors;
+        let mut wrist_ft_sensors = [FrameId(0); 2];
+        for (i, (slot, spec)) in wrist_ft_sensors
+            .iter_mut()
+            .zip([&ft.left_hand, &ft.right_hand])
+            .enumerate()
+        {
+            let hand = [&frames.left_hand, &frames.right_hand][i];
+            let wrist = FrameSpec {
+                link: hand.link.clone(),
+                translation: [0.0; 3],
+                rpy: [0.0; 3],
+            };
+            let key = ["ft_sensors.left_hand", "ft_sensors.right_hand"][i];
+            *slot = self.frame(
+                key,
+                WRIST_FT_SENSOR_FRAMES[i],
+                spec.as_ref().unwrap_or(&wrist),
+            )?;
+        }
+        // The default follows the sole, within the range a configured value must keep.
+        let palm_radius = section.palm_radius.unwrap_or_else(|| {
+            (PALM_RADIUS_PER_SOLE_WIDTH * section.sole.width)
+                .clamp(PALM_RADIUS_M.min, PALM_RADIUS_M.max)
+        });
+        if !PALM_RADIUS_M.contains(palm_radius) {
+            return Err(self.invalid(
+                "palm_radius",
+                format!("{} m must be in {PALM_RADIUS_M} m", Number(palm_radius)),
+            ));
+        }
         let groups = &section.joint_groups;
         let joint_groups = JointGroups {
             legs: self.joints("joint_groups.legs", &groups.legs)?,
@@ -391,6 +445,8 @@ impl Loader<'_> {
             end_effectors,
             sole: section.sole,
             ft_sensors,
+            wrist_ft_sensors,
+            palm_radius,
             joint_groups,
             standing,
         })

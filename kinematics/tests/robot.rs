@@ -325,3 +325,42 @@ fn an_unknown_section_is_refused() {
         &["unknown section [runtme]"],
     );
 }
+
+#[test]
+fn the_palm_and_the_wrist_sensors_default_to_the_sole_and_the_wrist() {
+    let jvrc1 = Robot::load(&config("jvrc1"), None).unwrap();
+    assert_eq!(jvrc1.palm_radius, 0.5 * jvrc1.sole.width);
+    // Configured: the URDF's wrist sensor links, at the wrist-yaw axis (0.07 m above the palm).
+    let mut kin = Kinematics::new(&jvrc1.model);
+    kin.update(&jvrc1.model, &jvrc1.standing);
+    let at = |frame| kin.frame_pose(&jvrc1.model, frame).translation.vector;
+    let arm = at(jvrc1.wrist_ft_sensors[1]) - at(jvrc1.frame(EndEffector::RightHand));
+    assert!((arm.norm() - 0.07).abs() < 1e-9, "{arm}");
+    // Without `left_hand`/`right_hand` the wrist sensor is the hand link's origin.
+    let unset = Robot::load(
+        &edited_jvrc1(
+            |t| {
+                t.replace("left_hand = { link = \"lhsensor\" }\n", "")
+                    .replace("right_hand = { link = \"rhsensor\" }\n", "")
+            },
+            "no-wrist-sensors",
+        ),
+        None,
+    )
+    .unwrap();
+    let mut kin = Kinematics::new(&unset.model);
+    kin.update(&unset.model, &unset.standing);
+    let wrist = kin.frame_pose(&unset.model, unset.wrist_ft_sensors[0]);
+    let link = unset.model.link_index("L_WRIST_Y_S").unwrap();
+    assert!((wrist.translation.vector - kin.link_pose(link).translation.vector).norm() < 1e-12);
+}
+
+#[test]
+fn a_palm_radius_out_of_range_is_refused_by_name() {
+    assert_edit_refused(
+        "palm-radius",
+        "sole = { length = 0.20, width = 0.08 }",
+        "sole = { length = 0.20, width = 0.08 }\npalm_radius = 0.5",
+        &["palm_radius", "0.5"],
+    );
+}

@@ -17,7 +17,7 @@ pub const WRENCH_ORDER: [&str; 4] = ["left_foot", "right_foot", "left_hand", "ri
 /// One sensor reading, adapter → daemon.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v5.SensorSample")]
+#[type_name("walk.v6.SensorSample")]
 pub struct SensorSample {
     /// Strictly increasing per adapter run.
     pub seq: u64,
@@ -53,7 +53,7 @@ wire_enum! {
 /// One joint command, daemon → adapter.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v5.JointCommand")]
+#[type_name("walk.v6.JointCommand")]
 pub struct JointCommand {
     /// Strictly increasing per daemon run.
     pub seq: u64,
@@ -196,7 +196,7 @@ wire_enum! {
 /// Percentiles of a latency distribution in microseconds.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("walk.v5.LatencySummary")]
+#[type_name("walk.v6.LatencySummary")]
 pub struct LatencySummary {
     /// Median.
     pub p50: f32,
@@ -213,7 +213,7 @@ pub const HISTOGRAM_BUCKETS: usize = 20;
 /// [2^b, 2^(b+1)) µs, the last bucket everything above.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("walk.v5.LogHistogram")]
+#[type_name("walk.v6.LogHistogram")]
 pub struct LogHistogram {
     /// Samples per bucket.
     pub counts: [u64; HISTOGRAM_BUCKETS],
@@ -229,7 +229,7 @@ impl LogHistogram {
 /// The daemon's state, published at a low rate (daemon → clients) and returned by `control`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v5.DaemonStatus")]
+#[type_name("walk.v6.DaemonStatus")]
 pub struct DaemonStatus {
     /// [`crate::PROTOCOL_VERSION`] of the daemon.
     pub protocol_version: u32,
@@ -384,7 +384,7 @@ pub const FAULT_TEXT: usize = 256;
 /// [`DaemonStatus`] (world frame, translation xyz + quaternion xyzw of the sole frames).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("walk.v5.SimTruth")]
+#[type_name("walk.v6.SimTruth")]
 pub struct SimTruth {
     /// Strictly increasing per simulator run (a gap means a subscriber missed messages).
     pub seq: u64,
@@ -413,6 +413,11 @@ pub struct SimTruth {
     /// and on the flat floor, where the legs have no collision geometry). Follows `actuators`
     /// (8-byte aligned, a multiple of 8 long) with no padding before it.
     pub terrain_collisions: u64,
+    /// The force (N, world axes) the environment exerts on each palm (left hand, right hand): a
+    /// railing it presses on, or the ground. Measured from the simulator's contact forces, not
+    /// from the wrist sensors the controller reads, so a hand's share of the robot's weight can
+    /// be judged (all zero from the kinematic simulator, which has no hand contacts).
+    pub hand_forces: [[f64; 3]; 2],
 }
 
 /// The load of a simulated robot's motors since the simulator started, against the URDF's limits:
@@ -423,7 +428,7 @@ pub struct SimTruth {
 /// group or joints without a limit).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("walk.v5.ActuatorLoad")]
+#[type_name("walk.v6.ActuatorLoad")]
 pub struct ActuatorLoad {
     /// Peak sustained torque as a fraction of the effort limit, per joint group.
     pub peak_torque_fraction: [f64; 4],
@@ -461,6 +466,7 @@ impl SimTruth {
         fallen: Flag::NO,
         actuators: ActuatorLoad::ZERO,
         terrain_collisions: 0,
+        hand_forces: [[0.0; 3]; 2],
     };
 }
 
@@ -473,7 +479,7 @@ impl Default for SimTruth {
 /// The daemon's answer to a submitted sequence.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v5.SubmitReply")]
+#[type_name("walk.v6.SubmitReply")]
 pub struct SubmitReply {
     /// Whether the sequence was validated, prepared and started.
     pub accepted: Flag,
@@ -524,7 +530,7 @@ wire_enum! {
 /// A control request (client → daemon).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v5.ControlRequest")]
+#[type_name("walk.v6.ControlRequest")]
 pub struct ControlRequest {
     /// The command.
     pub command: Code<ControlCommand>,
@@ -548,7 +554,7 @@ impl Default for ControlRequest {
 /// The daemon's answer to a control request.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
-#[type_name("walk.v5.ControlReply")]
+#[type_name("walk.v6.ControlReply")]
 pub struct ControlReply {
     /// Whether the command was carried out.
     pub accepted: Flag,
@@ -589,15 +595,17 @@ mod tests {
         }
     }
 
-    /// The field protocol v5 added ends the struct without padding before or after it, so the
-    /// layout is the same on every target iceoryx2 maps it on.
+    /// The fields protocols v5 and v6 added end the struct without padding before, between or
+    /// after them, so the layout is the same on every target iceoryx2 maps it on.
     #[test]
-    fn the_terrain_collision_count_ends_the_truth_without_padding() {
+    fn the_collision_count_and_the_palm_forces_end_the_truth_without_padding() {
         use std::mem::{offset_of, size_of};
         let after_actuators = offset_of!(SimTruth, actuators) + size_of::<ActuatorLoad>();
         assert_eq!(size_of::<ActuatorLoad>() % 8, 0);
         assert_eq!(offset_of!(SimTruth, terrain_collisions), after_actuators);
-        assert_eq!(size_of::<SimTruth>(), after_actuators + size_of::<u64>());
+        let after_count = after_actuators + size_of::<u64>();
+        assert_eq!(offset_of!(SimTruth, hand_forces), after_count);
+        assert_eq!(size_of::<SimTruth>(), after_count + size_of::<[[f64; 3]; 2]>());
     }
 
     #[test]

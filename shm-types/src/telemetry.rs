@@ -55,7 +55,7 @@ wire_enum! {
 /// What the controller estimated and aimed at in one control tick (walkd → observers).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v5.Telemetry")]
+#[type_name("walk.v6.Telemetry")]
 pub struct Telemetry {
     /// Increases by one with every telemetry published in a daemon run, from 1: a gap means a
     /// subscriber lost messages.

@@ -10,9 +10,10 @@ use std::sync::Arc;
 
 use kinematic_sim::Simulator;
 use kinematics::configuration::Configuration;
-use kinematics::robot::Robot;
+use kinematics::kinematics::Kinematics;
+use kinematics::robot::{EndEffector, Robot};
 use mujoco_rs::prelude::MjtObjBase;
-use nalgebra::Translation3;
+use nalgebra::{Translation3, Vector3};
 use shm_types::SimTruth;
 use sim_adapter::mujoco::{MujocoOptions, MujocoSim, Terrain};
 use sim_adapter::{GroundTruth, SimulatedRobot};
@@ -220,4 +221,86 @@ fn truth_of(sim: MujocoSim) -> SimTruth {
     };
     SimulatedRobot::new(sim).ground_truth(&mut truth);
     truth
+}
+
+#[test]
+fn a_palm_on_a_railing_is_read_at_its_wrist_and_in_the_truth() {
+    // JVRC-1 stands with a railing along x whose top is 1 mm into its right palm (a sphere of
+    // `palm_radius` around the hand frame): the rail pushes the palm up, and nothing else.
+    let robot = robot("jvrc1");
+    let flat = terrain("railing.toml");
+    let initial = flat.place(&robot.standing);
+    let palm = sim_on(&robot, flat, &initial)
+        .end_effector_pose(EndEffector::RightHand)
+        .translation
+        .vector;
+    let (radius, overlap) = (0.02, 0.001);
+    let top = palm.z - robot.palm_radius + overlap;
+    let scene = format!(
+        "format_version = 1\nname = \"rail-under-the-palm\"\n[path]\nstart = [0.0, 0.0]\n\
+         goal = [1.0, 0.0]\n[[surface]]\nname = \"ground\"\ncenter = [0.0, 0.0, 0.0]\n\
+         size = [4.0, 3.0]\n[[railing]]\nname = \"rail\"\nstart = [{}, {}, {}]\n\
+         end = [{}, {}, {}]\nradius = {radius}\n",
+        palm.x - 0.5,
+        palm.y,
+        top - radius,
+        palm.x + 0.5,
+        palm.y,
+        top - radius
+    );
+    let file =
+        std::env::temp_dir().join(format!("rail-under-the-palm-{}.toml", std::process::id()));
+    std::fs::write(&file, scene).unwrap();
+    let scene = Scene::from_path(&file).unwrap();
+    std::fs::remove_file(&file).unwrap();
+    let terrain = Terrain::from_scene(&scene).unwrap();
+    let mut sim = sim_on(&robot, terrain.clone(), &terrain.place(&robot.standing));
+    let q: Vec<f64> = robot.standing.joints.iter().copied().collect();
+    let qd = vec![0.0; q.len()];
+    for _ in 0..250 {
+        sim.step(&q, &qd, DT).unwrap();
+    }
+    let measured = sim.measurement().clone();
+    assert_eq!(
+        measured.contacts[2..],
+        [false, true],
+        "only the right palm touches"
+    );
+    let [left, right] = [measured.wrenches[2], measured.wrenches[3]];
+    assert_eq!(left, [0.0; 6]);
+    assert!(right[2] > 5.0, "the rail pushes the palm up: {right:?}");
+    eprintln!("right palm {right:?}, feet {:?}", &measured.wrenches[..2]);
+    assert!(
+        right[0].hypot(right[1]) < right[2],
+        "within the friction cone: {right:?}"
+    );
+    // About the wrist FT frame: the force acts at the palm's bottom, below the palm centre
+    // (within the overlap).
+    let mut posture = robot.standing.clone();
+    posture.base = measured.base;
+    posture.joints.copy_from(&measured.q);
+    let mut kinematics = Kinematics::new(&robot.model);
+    kinematics.update(&robot.model, &posture);
+    let at = |frame| {
+        kinematics
+            .frame_pose(&robot.model, frame)
+            .translation
+            .vector
+    };
+    let wrist = at(robot.wrist_ft_sensors[1]);
+    let contact = at(robot.frame(EndEffector::RightHand)) - Vector3::z() * robot.palm_radius;
+    let force = Vector3::new(right[0], right[1], right[2]);
+    let moment = (contact - wrist).cross(&force);
+    for k in 0..3 {
+        assert!(
+            (right[3 + k] - moment[k]).abs() < overlap * force.norm() + 1e-3,
+            "moment about the wrist {right:?} vs {moment:?}"
+        );
+    }
+    // The simulator's truth (protocol v6) carries the palm forces.
+    let truth = truth_of(sim);
+    assert_eq!(
+        truth.hand_forces,
+        [[0.0; 3], [right[0], right[1], right[2]]]
+    );
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use kinematics::robot::Robot;
-use stance::passes::run_passes;
+use stance::passes::{ContactGeometry, run_passes};
 use stance::{
     AffordanceSet, GenerateOptions, PostProcessParams, PostProcessedSequence, PostProcessor,
     generate,
@@ -56,7 +56,7 @@ fn bench_robot(c: &mut Criterion, name: &str) {
                 black_box(&mut work),
                 raw.environment(),
                 &params,
-                &robot.sole,
+                &ContactGeometry::of(&robot),
             );
         })
     });

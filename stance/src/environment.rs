@@ -1,6 +1,7 @@
 //! The environment a sequence is planned in: planar support surfaces for the feet and hand
 //! affordances (e.g. a railing) with the interval of the path along which they are available.
 
+use kinematics::robot::EndEffector;
 use nalgebra::{Isometry3, Point3, Vector2, Vector3};
 
 /// A planar support surface: its frame (z = surface normal, the plane is its xy plane) and the
@@ -143,12 +144,38 @@ fn polygon_contains(polygon: &[[f64; 2]], x: f64, y: f64) -> bool {
 pub struct HandAffordance {
     /// Name used in messages and files (e.g. `"railing"`).
     pub name: String,
-    /// First end of the segment in the world.
+    /// First end of the segment (the railing's axis) in the world.
     pub start: Vector3<f64>,
     /// Second end of the segment in the world.
     pub end: Vector3<f64>,
+    /// Radius of the railing around its axis (m): a held palm rests this far above the axis.
+    /// 0 for a stance source's own railing, a line.
+    pub radius: f64,
     /// `[from, to]`: the part of the path (metres from its origin) where the affordance may be used.
     pub available: [f64; 2],
+}
+
+impl HandAffordance {
+    /// The point of the segment nearest to `point`: where a hand reaching for the railing from
+    /// there grasps it.
+    pub fn nearest_on_axis(&self, point: &Vector3<f64>) -> Vector3<f64> {
+        let axis = self.end - self.start;
+        let t = (point - self.start).dot(&axis) / axis.norm_squared();
+        // A degenerate segment (start = end) gives NaN: its only point.
+        self.start + axis * if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) }
+    }
+
+    /// Whether `hand` may hold the railing: it lies on that hand's side of the walk (its
+    /// midpoint left of the path, `y > 0` in the walk's frame, for the left hand; right of it
+    /// for the right hand). A hand does not reach across the body for a railing.
+    pub fn is_on_the_side_of(&self, hand: EndEffector) -> bool {
+        let middle = (self.start.y + self.end.y) / 2.0;
+        match hand {
+            EndEffector::LeftHand => middle > 0.0,
+            EndEffector::RightHand => middle < 0.0,
+            EndEffector::LeftFoot | EndEffector::RightFoot => false,
+        }
+    }
 }
 
 /// Support surfaces and hand affordances of a sequence.

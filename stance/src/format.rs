@@ -7,14 +7,17 @@
 //!                                   "pose": { "translation": [0, 0, 0], "rotation": [0, 0, 0, 1] },
 //!                                   "polygon": null }],
 //!                    "hand_affordances": [{ "name": "railing", "start": [..], "end": [..],
-//!                                           "available": [0.0, 5.0] }] },
+//!                                           "radius": 0.02, "available": [0.0, 5.0] }] },
 //!   "stances": [{ "q": [..], "contacts": ["left_foot", "right_foot"],
 //!                 "translation": [x, y, z], "root_orientation": [x, y, z, w],
 //!                 "targets": { "left_foot": { "translation": [..], "rotation": [..] }, .. } }] }
 //! ```
 //! `targets` is present exactly in post-processed files; so is the optional `"gait": "static" |
 //! "dynamic"`, the gait whose limits post-processed the sequence and that walks it (absent: the
-//! robot config's default). `root_orientation` defaults to the identity. Unknown fields are errors;
+//! robot config's default). `root_orientation` defaults to the identity. A hand affordance's
+//! `radius` (m, ≥ 0: a railing's, around the axis from `start` to `end`) is optional and 0 when
+//! absent (a stance source's own railing, and files written before it existed); a radius of 0 is
+//! not written. Unknown fields are errors;
 //! a top-level value other than an object is refused as such. Quaternions are `[x, y, z, w]`.
 
 use kinematics::robot::{EndEffector, Robot};
@@ -115,7 +118,14 @@ struct HandAffordanceDto {
     name: String,
     start: [f64; 3],
     end: [f64; 3],
+    #[serde(default, skip_serializing_if = "is_zero")]
+    radius: f64,
     available: [f64; 2],
+}
+
+/// Whether an optional number is at its default, 0, and so not written.
+fn is_zero(value: &f64) -> bool {
+    *value == 0.0
 }
 
 fn quaternion(xyzw: [f64; 4]) -> UnitQuaternion<f64> {
@@ -165,6 +175,7 @@ impl From<EnvironmentDto> for Environment {
                     name: h.name,
                     start: h.start.into(),
                     end: h.end.into(),
+                    radius: h.radius,
                     available: h.available,
                 })
                 .collect(),
@@ -191,6 +202,7 @@ impl From<&Environment> for EnvironmentDto {
                     name: h.name.clone(),
                     start: h.start.into(),
                     end: h.end.into(),
+                    radius: h.radius,
                     available: h.available,
                 })
                 .collect(),

@@ -4,7 +4,7 @@
 //! - [`Stance`], [`RawSequence`], [`PostProcessedSequence`], [`Environment`]: the data model,
 //!   validated on construction and read/written as versioned JSON ([`format`]).
 //! - [`PoseSequence`]: world poses of root and end-effectors per stance, the passes' working form.
-//! - [`passes`]: Algorithm 1's nine passes and the terrain pass, each a function;
+//! - [`passes`]: Algorithm 1's nine passes, the terrain pass and the hand pass, each a function;
 //!   [`PostProcessor`] runs FK + all passes with reusable buffers.
 //! - [`generate()`]: a human-like, impeded stance source; `learned` (feature `learned`): the
 //!   n-gram model trained on human demonstrations.
@@ -47,5 +47,5 @@ pub use params::{ContactUnification, Gait, GaitUnavailable, ParamsError, PostPro
 pub use pipeline::PostProcessor;
 pub use poses::PoseSequence;
 pub use scene::{Scene, SceneError};
-pub use sequence::{PostProcessedSequence, RawSequence, Stance, StanceSequence};
-pub use walk::{WalkRequest, synthetic_walk, walk_on};
+pub use sequence::{NoRailing, PostProcessedSequence, RawSequence, Stance, StanceSequence};
+pub use walk::{WalkRequest, synthetic_walk, walk_in};

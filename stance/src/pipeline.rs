@@ -8,7 +8,7 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 
 use crate::error::FormatError;
 use crate::params::PostProcessParams;
-use crate::passes::{Pass, run_passes, run_passes_observed};
+use crate::passes::{ContactGeometry, Pass, run_passes, run_passes_observed};
 use crate::poses::PoseSequence;
 use crate::sequence::{PostProcessedSequence, RawSequence, Stance};
 
@@ -86,7 +86,7 @@ impl<'r> PostProcessor<'r> {
             &mut self.poses,
             raw.environment(),
             &self.params,
-            &self.robot.sole,
+            &ContactGeometry::of(self.robot),
         );
         out.assign(raw, &self.poses);
         out.gait = Some(self.params.gait);
@@ -104,7 +104,7 @@ impl<'r> PostProcessor<'r> {
             &mut self.poses,
             raw.environment(),
             &self.params,
-            &self.robot.sole,
+            &ContactGeometry::of(self.robot),
             after,
         );
         let mut out = PostProcessedSequence::empty();

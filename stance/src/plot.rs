@@ -1,6 +1,7 @@
 //! The paper's Fig. 3 as SVG: the feet after each pass of Algorithm 1 seen from above (left
-//! foot green, right foot blue, contact poses with a red border) and a side view of the swing
-//! foot heights. Coordinates are along / across the walking path.
+//! foot green, right foot blue, contact poses with a red border; held hands as magenta dots,
+//! which the hand pass puts on their railing) and a side view of the swing foot heights.
+//! Coordinates are along / across the walking path.
 
 use std::path::{Path, PathBuf};
 
@@ -12,7 +13,7 @@ use crate::environment::Environment;
 use crate::geometry::PathFrame;
 use crate::params::PostProcessParams;
 use crate::passes::{Pass, path_of};
-use crate::poses::{FEET, PoseSequence};
+use crate::poses::{FEET, HANDS, PoseSequence};
 
 /// The poses right after one pass.
 #[derive(Clone, Debug)]
@@ -112,12 +113,26 @@ fn draw_top(
                 )
             })
             .collect();
+        let held: Vec<(f64, f64)> = (0..poses.len())
+            .flat_map(|i| HANDS.map(|hand| (i, hand)))
+            .filter(|&(i, hand)| poses.in_contact(i, hand))
+            .map(|(i, hand)| {
+                let p = poses.pose(i, hand).translation.vector;
+                (path.along(&p), path.lateral(&p))
+            })
+            .collect();
         let along = range(
-            outlines.iter().flat_map(|(_, _, o)| o.iter().map(|p| p.0)),
+            outlines
+                .iter()
+                .flat_map(|(_, _, o)| o.iter().map(|p| p.0))
+                .chain(held.iter().map(|p| p.0)),
             0.1,
         );
         let lateral = range(
-            outlines.iter().flat_map(|(_, _, o)| o.iter().map(|p| p.1)),
+            outlines
+                .iter()
+                .flat_map(|(_, _, o)| o.iter().map(|p| p.1))
+                .chain(held.iter().map(|p| p.1)),
             0.05,
         );
         let mut chart = ChartBuilder::on(area)
@@ -151,6 +166,10 @@ fn draw_top(
                 )))?;
             }
         }
+        chart.draw_series(
+            held.into_iter()
+                .map(|p| Circle::new(p, 3, MAGENTA.filled())),
+        )?;
     }
     root.present()?;
     Ok(())

@@ -61,11 +61,9 @@ pub struct Scene {
     /// The scene's `name`, for reports and file names.
     pub name: String,
     /// The support surfaces (one per `[[surface]]`, in file order, bounded by their rectangles)
-    /// and the railings as hand affordances (one per `[[railing]]`, in file order).
+    /// and the railings as hand affordances (one per `[[railing]]`, in file order, with their
+    /// radii).
     pub environment: Environment,
-    /// The radius (m) of each railing, in the order of `environment.hand_affordances`: the
-    /// physics needs it for the railing's capsule, the planner does not.
-    pub railing_radii: Vec<f64>,
     /// Where the walk starts: on the surface under `path.start`, facing `start_yaw_deg` about
     /// world z (x forward, z up).
     pub start: Isometry3<f64>,
@@ -457,14 +455,12 @@ impl Validator<'_> {
                 .to_radians(),
             None => (goal - start).y.atan2((goal - start).x),
         };
-        let (radii, hand_affordances) = dto
+        let hand_affordances = dto
             .railing
             .iter()
             .enumerate()
             .map(|(i, railing)| self.railing(i, railing, (goal - start).norm()))
-            .collect::<Result<Vec<_>, _>>()?
-            .into_iter()
-            .unzip();
+            .collect::<Result<Vec<_>, _>>()?;
 
         self.unique_names("surface", dto.surface.iter().map(|s| s.name.as_str()))?;
         self.unique_names("railing", dto.railing.iter().map(|r| r.name.as_str()))?;
@@ -487,7 +483,6 @@ impl Validator<'_> {
                 surfaces: placed.into_iter().map(|p| p.surface).collect(),
                 hand_affordances,
             },
-            railing_radii: radii,
         })
     }
 
@@ -541,13 +536,13 @@ impl Validator<'_> {
         })
     }
 
-    /// A railing and its radius; `available` defaults to the whole path (`[0, length]`).
+    /// A railing; `available` defaults to the whole path (`[0, length]`).
     fn railing(
         &self,
         index: usize,
         dto: &RailingDto,
         length: f64,
-    ) -> Result<(f64, HandAffordance), SceneError> {
+    ) -> Result<HandAffordance, SceneError> {
         let item = label("railing", index, &dto.name);
         self.numbers(&item, "start", &dto.start.0, Rule::Finite)?;
         self.numbers(&item, "end", &dto.end.0, Rule::Finite)?;
@@ -570,15 +565,13 @@ impl Validator<'_> {
                 point: dto.start.0,
             });
         }
-        Ok((
+        Ok(HandAffordance {
+            name: dto.name.clone(),
+            start: dto.start.0.into(),
+            end: dto.end.0.into(),
             radius,
-            HandAffordance {
-                name: dto.name.clone(),
-                start: dto.start.0.into(),
-                end: dto.end.0.into(),
-                available,
-            },
-        ))
+            available,
+        })
     }
 
     fn unique_names<'n>(
@@ -835,7 +828,10 @@ mod tests {
             (railing.end - Vector3::new(-0.45, -4.5, 0.8)).norm() < 1e-12,
             "{railing:?}"
         );
-        assert_eq!(railing.available, original.available);
+        assert_eq!(
+            (railing.radius, railing.available),
+            (original.radius, original.available)
+        );
     }
 
     #[test]

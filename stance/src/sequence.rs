@@ -5,9 +5,10 @@
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-use crate::environment::{Environment, SupportSurface};
+use crate::environment::Environment;
 use crate::error::{FormatError, Location};
 use crate::params::Gait;
+use crate::poses::HANDS;
 
 /// One stance `S = { q_S, c_S(lf), c_S(rf), c_S(lh), c_S(rh), t_S }`.
 #[derive(Clone, Debug, PartialEq)]
@@ -157,12 +158,47 @@ impl RawSequence {
         })
     }
 
-    /// The same walk on other support surfaces (a scene's, in the walk's frame): a stance source
-    /// generates on flat ground, and post-processing puts the walk onto these.
-    pub fn on_surfaces(mut self, surfaces: &[SupportSurface]) -> Self {
-        self.sequence.environment.surfaces = surfaces.to_vec();
-        self
+    /// The same walk in another environment (a scene's, in the walk's frame:
+    /// [`crate::Scene::walk_environment`]): its surfaces, and its railings as the hand
+    /// affordances in place of the stance source's own. A stance source generates on flat
+    /// ground; post-processing puts the walk onto these surfaces and its held hands onto these
+    /// railings. Refused if a hand is held in some stance and the environment has no railing on
+    /// that hand's side ([`crate::HandAffordance::is_on_the_side_of`]).
+    pub fn in_environment(mut self, environment: Environment) -> Result<Self, NoRailing> {
+        let railing_for = |hand| {
+            environment
+                .hand_affordances
+                .iter()
+                .any(|railing| railing.is_on_the_side_of(hand))
+        };
+        let held = self.stances.iter().enumerate().find_map(|(stance, s)| {
+            HANDS
+                .into_iter()
+                .find(|&hand| s.in_contact(hand) && !railing_for(hand))
+                .map(|hand| NoRailing { hand, stance })
+        });
+        if let Some(refusal) = held {
+            return Err(refusal);
+        }
+        self.sequence.environment = environment;
+        Ok(self)
     }
+}
+
+/// Why a walk cannot be put in an environment ([`RawSequence::in_environment`]): a hand holds a
+/// railing in the walk and the environment has none on its side to hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "the sequence holds a hand on a railing ({} from stance {stance}) but the scene has none on \
+     that side of the path (a [[railing]] whose middle is {} of the line from start to goal)",
+    hand.name(),
+    if *hand == EndEffector::LeftHand { "left" } else { "right" }
+)]
+pub struct NoRailing {
+    /// The first held hand.
+    pub hand: EndEffector,
+    /// The first stance it is held in.
+    pub stance: usize,
 }
 
 impl PostProcessedSequence {
@@ -400,6 +436,13 @@ fn validate_environment(environment: &Environment) -> Result<(), FormatError> {
         finite(affordance.start.as_slice(), || field("start"))?;
         finite(affordance.end.as_slice(), || field("end"))?;
         finite(&affordance.available, || field("available"))?;
+        finite(&[affordance.radius], || field("radius"))?;
+        if affordance.radius < 0.0 {
+            return Err(FormatError::Invalid {
+                location: field("radius"),
+                message: format!("{} m: a radius is ≥ 0", affordance.radius),
+            });
+        }
         if affordance.available[0] > affordance.available[1] {
             return Err(FormatError::Invalid {
                 location: field("available"),

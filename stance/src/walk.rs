@@ -5,12 +5,12 @@
 
 use kinematics::robot::Robot;
 
-use crate::environment::SupportSurface;
+use crate::environment::{Environment, SupportSurface};
 use crate::error::FormatError;
 use crate::generate::{AffordanceSet, GenerateError, GenerateOptions, generate};
 use crate::params::PostProcessParams;
 use crate::pipeline::PostProcessor;
-use crate::sequence::{PostProcessedSequence, RawSequence};
+use crate::sequence::{NoRailing, PostProcessedSequence, RawSequence};
 
 /// A walk to generate: how far it should reach after post-processing, with what, which seed.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,20 +49,27 @@ pub enum WalkError<E: std::error::Error> {
     /// The stance source generated nothing.
     #[error("generating the stance sequence: {0}")]
     Source(E),
+    /// The walk holds a railing the scene does not have.
+    #[error("putting the walk in the scene: {0}")]
+    Scene(NoRailing),
     /// Algorithm 1 refused the raw sequence.
     #[error("post-processing the stance sequence: {0}")]
     PostProcess(FormatError),
 }
 
 /// The walk of `request` on flat ground: `source` generates the raw sequence for the options of
-/// [`WalkRequest::generate_options`], then it is post-processed with `params`.
+/// [`WalkRequest::generate_options`], then it is post-processed with `params` in the source's
+/// own environment (the ground, and its railing for a held hand).
 pub fn walk_with<E: std::error::Error>(
     robot: &Robot,
     params: &PostProcessParams,
     request: &WalkRequest,
-    source: impl FnMut(&GenerateOptions) -> Result<RawSequence, E>,
+    mut source: impl FnMut(&GenerateOptions) -> Result<RawSequence, E>,
 ) -> Result<PostProcessedSequence, WalkError<E>> {
-    walk_on(robot, params, request, &[SupportSurface::ground()], source)
+    let raw = source(&request.generate_options(params)).map_err(WalkError::Source)?;
+    PostProcessor::new(robot, params.clone())
+        .process(&raw)
+        .map_err(WalkError::PostProcess)
 }
 
 /// How many times longer than its path a walk on terrain is generated, in the order tried:
@@ -72,15 +79,17 @@ pub fn walk_with<E: std::error::Error>(
 /// walk than needed would only bring in more of the source's sideways wander.
 pub const TERRAIN_DISTANCE_MARGINS: [f64; 3] = [1.0, 1.5, 2.0];
 
-/// [`walk_with`] on `surfaces` (a scene's, in the walk's frame: [`crate::Scene::walk_environment`]):
-/// the source's flat walk is post-processed onto them; unless they are the flat ground, it is
-/// generated longer ([`TERRAIN_DISTANCE_MARGINS`]) until it reaches `request.distance`, and
-/// ended there.
-pub fn walk_on<E: std::error::Error>(
+/// [`walk_with`] in `environment`, a scene's in the walk's frame
+/// ([`crate::Scene::walk_environment`]): the source's flat walk is put in it
+/// ([`RawSequence::in_environment`]: its surfaces, its railings for the held hands) and
+/// post-processed onto it; unless its surfaces are the flat ground, it is generated longer
+/// ([`TERRAIN_DISTANCE_MARGINS`]) until it reaches `request.distance`, and ended there. Refused
+/// ([`WalkError::Scene`]) if the walk holds a hand and the scene has no railing.
+pub fn walk_in<E: std::error::Error>(
     robot: &Robot,
     params: &PostProcessParams,
     request: &WalkRequest,
-    surfaces: &[SupportSurface],
+    environment: &Environment,
     mut source: impl FnMut(&GenerateOptions) -> Result<RawSequence, E>,
 ) -> Result<PostProcessedSequence, WalkError<E>> {
     let options = request.generate_options(params);
@@ -91,11 +100,16 @@ pub fn walk_on<E: std::error::Error>(
             ..options
         };
         let raw = source(&longer).map_err(WalkError::Source)?;
-        processor
-            .process(&raw.on_surfaces(surfaces))
-            .map_err(WalkError::PostProcess)
+        let raw = raw
+            .in_environment(environment.clone())
+            .map_err(WalkError::Scene)?;
+        processor.process(&raw).map_err(WalkError::PostProcess)
     };
-    if surfaces.iter().all(SupportSurface::is_ground_plane) {
+    if environment
+        .surfaces
+        .iter()
+        .all(SupportSurface::is_ground_plane)
+    {
         return walk(1.0);
     }
     let mut longest = None;

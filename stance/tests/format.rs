@@ -312,3 +312,32 @@ fn a_file_that_is_not_an_object_is_refused_as_such() {
         }
     }
 }
+
+#[test]
+fn a_railing_radius_is_optional_and_zero_when_absent() {
+    let text = raw().to_json_string();
+    let railing = "/environment/hand_affordances/0";
+    // The source's own railing has no radius, and a radius of 0 is not written: files from
+    // before the field existed read the same.
+    let value: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(value.pointer(&format!("{railing}/radius")), None);
+    assert_eq!(raw().environment().hand_affordances[0].radius, 0.0);
+    // A scene's railing keeps its radius through the file.
+    let thick = read_edited(|v| {
+        v.pointer_mut(railing).unwrap()["radius"] = json!(0.02);
+    })
+    .unwrap();
+    assert_eq!(thick.environment().hand_affordances[0].radius, 0.02);
+    let again = RawSequence::from_json_str(&thick.to_json_string(), &common::jvrc1().0).unwrap();
+    assert_eq!(again, thick);
+    // A negative radius is refused, naming the field.
+    let err = read_edited(|v| {
+        v.pointer_mut(railing).unwrap()["radius"] = json!(-0.02);
+    })
+    .unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("environment.hand_affordances[0].radius"),
+        "{err}"
+    );
+}

@@ -1,6 +1,6 @@
 //! Property tests of Algorithm 1 (DESIGN.md §4) over random impeded sequences from the
 //! human-like source, for ARMAR-4 and JVRC-1 and all three affordance sets: every invariant after
-//! the passes, and idempotence with scf = 1.
+//! the passes (held hands on top of their railing included), and idempotence with scf = 1.
 
 mod common;
 
@@ -10,8 +10,8 @@ use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 use stance::derived::{jumping_contacts, orthogonal_distances, steps, swing_heights};
 use stance::geometry::roll_pitch_yaw;
-use stance::passes::{path_of, run_passes};
-use stance::poses::FEET;
+use stance::passes::{ContactGeometry, path_of, run_passes};
+use stance::poses::{FEET, HANDS};
 use stance::{
     AffordanceSet, GenerateOptions, PostProcessParams, PostProcessor, RawSequence, generate,
 };
@@ -111,6 +111,25 @@ fn check_invariants(
             }
         }
     }
+    // Held hands on top of their railing: the palm on the nearest point of its axis.
+    for i in 0..poses.len() {
+        for hand in HANDS {
+            if !poses.in_contact(i, hand) {
+                continue;
+            }
+            let p = poses.pose(i, hand).translation.vector;
+            let on_top = |railing: &stance::HandAffordance| {
+                let axis = railing.nearest_on_axis(&p);
+                (p - axis - Vector3::z() * (railing.radius + robot.palm_radius)).norm()
+            };
+            let off = env
+                .hand_affordances
+                .iter()
+                .map(on_top)
+                .fold(f64::INFINITY, f64::min);
+            prop_assert!(off < EPS, "stance {i} {hand:?}: {off} m off its railing");
+        }
+    }
     // No jumping contacts.
     for e in EndEffector::ALL {
         prop_assert_eq!(
@@ -158,7 +177,12 @@ fn check_idempotent(
         .map_err(|e| TestCaseError::fail(e.to_string()))?;
     let once = out.to_poses();
     let mut twice = once.clone();
-    run_passes(&mut twice, raw.environment(), &params, &robot.sole);
+    run_passes(
+        &mut twice,
+        raw.environment(),
+        &params,
+        &ContactGeometry::of(robot),
+    );
     for i in 0..once.len() {
         prop_assert!(
             (once.roots[i].translation.vector - twice.roots[i].translation.vector).norm() < EPS

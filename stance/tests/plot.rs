@@ -1,4 +1,5 @@
-//! `plot::write_fig3` draws one top-view panel per pass and the swing-height side view.
+//! `plot::write_fig3` draws one top-view panel per pass (held hands included) and the
+//! swing-height side view.
 
 mod common;
 
@@ -12,7 +13,7 @@ fn fig3_has_a_panel_per_pass_and_a_side_view() {
         robot,
         &GenerateOptions {
             distance: 4.0,
-            affordances: AffordanceSet::Feet,
+            affordances: AffordanceSet::FeetRightHand,
             seed: 2,
         },
     )
@@ -38,6 +39,7 @@ fn fig3_has_a_panel_per_pass_and_a_side_view() {
         );
     }
     assert!(top.contains("#FF0000"), "contact poses are marked red");
+    assert!(top.contains("#FF00FF"), "held hands are magenta dots");
     let side = std::fs::read_to_string(&files[1]).unwrap();
     assert!(side.contains("swing-foot height"));
     std::fs::remove_dir_all(&dir).unwrap();

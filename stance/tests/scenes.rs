@@ -131,10 +131,10 @@ fn ramps_rise_by_two_metres_times_the_tangent_without_a_step() {
 #[test]
 fn railing_runs_along_the_path_on_the_right() {
     let scene = committed("railing");
-    assert_eq!(scene.railing_radii, [0.02]);
     let [railing] = scene.environment.hand_affordances.as_slice() else {
         panic!("one railing expected");
     };
+    assert_eq!(railing.radius, 0.02);
     assert_eq!(railing.available, [0.0, 5.0]);
     assert_eq!(railing.start, Vector3::new(-0.5, -0.45, 0.8));
     assert_eq!(railing.end, Vector3::new(5.5, -0.45, 0.8));

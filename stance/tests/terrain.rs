@@ -1,9 +1,9 @@
 //! Walks put onto the committed scenes: a JVRC-1 walk from the synthetic source, asked for the
-//! way every walking command asks for one (`stance::walk_on`), post-processed with a gait's
+//! way every walking command asks for one (`stance::walk_in`), post-processed with a gait's
 //! limits. Every foothold fits its surface, one foot per stair where the step limit takes two
 //! treads and both feet on each otherwise, the walk ends at the goal, on its surface, and every
 //! swing clears what it passes. And a flat walk comes out of post-processing exactly as it did
-//! before the terrain pass existed.
+//! before the terrain pass existed, but for its held hands, now on top of their railing.
 
 mod common;
 
@@ -13,7 +13,9 @@ use kinematics::ConfigFile;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Point3, Vector3};
 use stance::derived::{steps, swing_reference};
-use stance::passes::{HEEL_MARGIN_M, SHORT_SURFACE_SOLES, TOE_MARGIN_M, path_of};
+use stance::passes::{
+    HEEL_MARGIN_M, SHORT_SURFACE_SOLES, TOE_MARGIN_M, hold_hand_affordances, path_of,
+};
 use stance::poses::FEET;
 use stance::{
     AffordanceSet, Environment, Gait, GenerateOptions, PoseSequence, PostProcessParams,
@@ -41,10 +43,10 @@ fn scene(name: &str) -> Scene {
     Scene::from_path(&path).unwrap()
 }
 
-/// A walk on `scene` as every walking command asks for it (`stance::walk_on`: generated flat,
+/// A walk on `scene` as every walking command asks for it (`stance::walk_in`: generated flat,
 /// longer than the path, the walk environment attached, post-processed with the limits of
 /// `gait`, `s_max` replaced if given, and ended at the goal).
-fn walk_on(
+fn walk_in(
     scene: &Scene,
     gait: Gait,
     s_max: Option<f64>,
@@ -60,7 +62,7 @@ fn walk_on(
         affordances: AffordanceSet::Feet,
         seed,
     };
-    let out = stance::walk_on(robot, &params, &request, &environment.surfaces, |options| {
+    let out = stance::walk_in(robot, &params, &request, &environment, |options| {
         generate(robot, options)
     })
     .unwrap();
@@ -309,7 +311,7 @@ fn check_walk(
     seed: u64,
 ) -> (PoseSequence, Vec<String>) {
     let (robot, params) = jvrc1(gait);
-    let (out, environment) = walk_on(scene, gait, s_max, seed);
+    let (out, environment) = walk_in(scene, gait, s_max, seed);
     let poses = out.to_poses();
     check_soles_fit(&poses, &environment, [robot.sole.length, robot.sole.width]);
     let surfaces = check_feet_per_stair(&poses, &environment, robot.sole.length, per_stair);
@@ -408,7 +410,9 @@ fn ramp_soles_are_pitched_with_the_ramp() {
 
 /// The flat walks of `tests/data/flat-*.json` were post-processed by this crate before the
 /// terrain pass existed (commit c6b778b); post-processing them now gives the same sequence, to
-/// the bit: on the flat ground the terrain pass and the new pass 9 change nothing.
+/// the bit, but for the held hands: on the flat ground the terrain pass and the new pass 9
+/// change nothing, and the hand pass puts each held hand on top of the source's own railing
+/// (what `hold_hand_affordances` makes of the stored sequence).
 #[test]
 fn flat_walks_are_post_processed_as_before_the_terrain_pass() {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
@@ -433,6 +437,17 @@ fn flat_walks_are_post_processed_as_before_the_terrain_pass() {
     for (file, robot, params, distance, affordances, seed) in cases {
         let text = std::fs::read_to_string(data.join(file)).unwrap();
         let before = PostProcessedSequence::from_json_str(&text, robot).unwrap();
+        let mut held = before.to_poses();
+        hold_hand_affordances(&mut held, before.environment(), robot.palm_radius);
+        let expected = PostProcessedSequence::new(
+            before.robot().to_owned(),
+            before.joint_names().to_vec(),
+            before.environment().clone(),
+            before.stances().to_vec(),
+            held.end_effectors,
+        )
+        .unwrap()
+        .with_gait(before.gait());
         let options = GenerateOptions {
             distance: distance / params.scf,
             affordances,
@@ -440,11 +455,23 @@ fn flat_walks_are_post_processed_as_before_the_terrain_pass() {
         };
         let raw = generate(robot, &options).unwrap();
         let now = PostProcessor::new(robot, params).process(&raw).unwrap();
-        assert!(now == before, "{file}: post-processing changed");
+        assert!(now == expected, "{file}: post-processing changed");
         assert_eq!(
             now.to_json_string(),
-            text,
+            expected.to_json_string(),
             "{file}: not the same to the bit"
         );
+        if affordances == AffordanceSet::Feet {
+            assert_eq!(
+                now.to_json_string(),
+                text,
+                "{file}: not the same to the bit"
+            );
+        } else {
+            assert!(
+                now != before,
+                "{file}: the held hands moved onto the railing"
+            );
+        }
     }
 }

@@ -107,8 +107,18 @@ fn jvrc1_walks_the_dynamic_gait_kinematically_in_real_time() {
 
 /// Runs `walkctl evaluate` for one short feet-only walk of `robot` and returns its JSON run.
 fn evaluate_walk(robot: &str, physics: &str, distance: f64) -> serde_json::Value {
+    evaluate_walk_with(robot, "feet", physics, distance)
+}
+
+/// [`evaluate_walk`] with the affordance set `affordances`.
+fn evaluate_walk_with(
+    robot: &str,
+    affordances: &str,
+    physics: &str,
+    distance: f64,
+) -> serde_json::Value {
     let output = Command::new(bin_dir().join("walkctl"))
-        .args(["evaluate", "--robots", robot, "--affordances", "feet"])
+        .args(["evaluate", "--robots", robot, "--affordances", affordances])
         .args(["--distances", &distance.to_string(), "--runs", "1"])
         .args(["--physics", physics, "--json"])
         .args([
@@ -148,6 +158,18 @@ fn jvrc1_walks_under_mujoco_physics_without_falling() {
     assert_tracked_truth(&run, 0.02);
     // Upright all the way (the fall rule is 0.6 rad).
     assert!(run["max_tilt_rad"].as_f64().unwrap() < 0.1, "{run}");
+}
+
+/// A walk that holds the left hand on a railing, in a MuJoCo world without one (the flat
+/// floor): the hand presses on nothing (it sinks `hand_press_depth_m` at most, docs/controller.md,
+/// "Hands on a railing"), and the walk goes on without it to the end, upright, the simulator
+/// reading no force on the palm.
+#[test]
+fn a_hand_that_finds_no_railing_leaves_the_walk_to_the_feet() {
+    let run = evaluate_walk_with("jvrc1", "feet+left-hand", "mujoco", 0.4);
+    assert!(run["max_tilt_rad"].as_f64().unwrap() < 0.1, "{run}");
+    let share = run["hand_support_share"].as_f64().expect("a held hand");
+    assert!(share.abs() < 1e-9, "the palm touched something: {run}");
 }
 
 #[test]

@@ -58,6 +58,8 @@ pub(crate) struct WatchedWalk {
     pub targets: Vec<Points>,
     /// The walk's statuses as a Fig. 6 trace, with the simulator's truth where it pairs.
     pub trace: Vec<TraceSample>,
+    /// When each status of the trace was written ([`shm_types::monotonic_ns`]).
+    pub status_times: Vec<u64>,
     /// Largest controller-vs-simulator CoM or sole distance (m) and the statuses it is the
     /// maximum over; `None` when no status paired with a simulator state.
     pub drift: Option<(f64, usize)>,
@@ -140,6 +142,7 @@ pub(crate) fn watch_walk(
         states,
         targets,
         trace,
+        status_times,
         drift,
         balance,
         state_changes,

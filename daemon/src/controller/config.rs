@@ -130,6 +130,21 @@ pub struct ControllerConfig {
     /// makes the stance foot slip about its vertical axis; a robot with heavy arms and little
     /// ankle roll (ARMAR-4) cannot balance with the arm left out to the side.
     pub carry_released_hands: bool,
+    /// How high (m) a hand's reach arcs above the straight line to its contact, at its middle:
+    /// it comes down onto the top of a railing instead of sweeping into it from below.
+    pub hand_approach_height_m: f64,
+    /// The vertical force (N) a held hand presses on its support with, measured at its wrist:
+    /// enough to know it is there, little enough not to unload a foot the balance does not
+    /// expect to be unloaded (`hand_press`).
+    pub hand_force_n: f64,
+    /// Admittance of a held hand's target along the vertical (m/s per N of force error): how
+    /// fast it rises when the hand presses harder than `hand_force_n` and sinks when softer.
+    pub hand_admittance: f64,
+    /// Fastest the admittance moves a held hand's target (m/s).
+    pub hand_press_speed: f64,
+    /// Farthest the admittance moves a held hand's target from its planned pose, either way (m):
+    /// a hand that finds no support sinks this far at most.
+    pub hand_press_depth_m: f64,
     /// A joint measured this far beyond its URDF limits is an invalid measurement (an encoder
     /// or calibration fault): the controller faults, naming the joint (rad).
     pub joint_limit_tolerance_rad: f64,
@@ -197,6 +212,11 @@ impl Default for ControllerConfig {
             tipping_detection_rad: 0.25,
             heading_correction_speed: 0.05,
             carry_released_hands: false,
+            hand_approach_height_m: 0.08,
+            hand_force_n: 10.0,
+            hand_admittance: 5e-4,
+            hand_press_speed: 0.05,
+            hand_press_depth_m: 0.01,
             joint_limit_tolerance_rad: 0.03,
             workspace_radius_m: 100.0,
             workspace_depth_m: 3.0,
@@ -386,6 +406,16 @@ impl ControllerConfig {
                 0.0,
                 10.0,
             ),
+            Bound::new(
+                "hand_approach_height_m",
+                self.hand_approach_height_m,
+                0.0,
+                0.5,
+            ),
+            Bound::new("hand_force_n", self.hand_force_n, 0.0, 1000.0),
+            Bound::new("hand_admittance", self.hand_admittance, 0.0, 0.01),
+            Bound::new("hand_press_speed", self.hand_press_speed, 0.0, 1.0),
+            Bound::new("hand_press_depth_m", self.hand_press_depth_m, 0.0, 0.2),
             Bound::new(
                 "joint_limit_tolerance_rad",
                 self.joint_limit_tolerance_rad,

@@ -63,6 +63,21 @@ pub(crate) struct Targets {
 }
 
 impl Targets {
+    /// No contact and no task: the targets before a first stance.
+    pub fn none() -> Self {
+        Self {
+            contacts: [false; 4],
+            anchors: [Isometry3::identity(); 4],
+            com: Vector2::zeros(),
+            com_velocity: Vector2::zeros(),
+            end_effectors: [None; 4],
+            unloading: None,
+            balance: Balance::SupportPolygon { height: None },
+            contact_velocity: [[0.0; 6]; 2],
+            torso_posture_weight: None,
+        }
+    }
+
     /// Moves every anchor by `motion` (a turn of the world the anchors are held in: the
     /// estimate's heading correction, which moves nothing on the robot).
     pub fn move_anchors(&mut self, motion: &Isometry3<f64>) {
@@ -206,17 +221,7 @@ impl StateMachine {
             com_climb: None,
             free_targets: [None; 4],
             carried: [None; 4],
-            targets: Targets {
-                contacts: [false; 4],
-                anchors: [Isometry3::identity(); 4],
-                com: Vector2::zeros(),
-                com_velocity: Vector2::zeros(),
-                end_effectors: [None; 4],
-                unloading: None,
-                balance: Balance::SupportPolygon { height: None },
-                contact_velocity: [[0.0; 6]; 2],
-                torso_posture_weight: None,
-            },
+            targets: Targets::none(),
         }
     }
 
@@ -485,6 +490,7 @@ impl StateMachine {
                 let start = feedback.poses[hand as usize];
                 let goal = self.world_target(hand);
                 self.timed_motion(start, goal, Profile::MinimumJerk);
+                self.motion = self.motion.lifted(c.hand_approach_height_m);
                 self.motion.duration()
             }
             (phase, None) => unreachable!("phase {phase:?} needs an end-effector"),

@@ -39,6 +39,7 @@ mod assembly;
 mod config;
 mod estimator;
 mod gait;
+mod hand_press;
 mod machine;
 mod plan;
 mod sequence;
@@ -67,6 +68,7 @@ pub use telemetry::ControllerTelemetry;
 use assembly::QpAssembler;
 use estimator::BaseEstimator;
 use gait::{DynamicPlan, Sensors};
+use hand_press::HandPress;
 use machine::{Feedback, Progress};
 use sequencer::Sequencer;
 
@@ -241,6 +243,8 @@ pub struct Controller {
     last_imu: Option<UnitQuaternion<f64>>,
     /// The wrenches of the last valid measurement (a tick on the last valid state reads them).
     last_wrenches: [[f64; 6]; 4],
+    /// The held hands' force regulation on their targets.
+    hand_press: HandPress,
     /// Joint angles and velocities of a tick on the last valid state (preallocated).
     substitute_q: Vec<f64>,
     substitute_qd: Vec<f64>,
@@ -285,6 +289,7 @@ impl Controller {
             measurement_refused: false,
             last_imu: None,
             last_wrenches: [[0.0; 6]; 4],
+            hand_press: HandPress::default(),
             substitute_q: vec![0.0; model.dof()],
             substitute_qd: vec![0.0; model.dof()],
             stop_ends_in: ControllerState::Holding,
@@ -575,13 +580,16 @@ impl Controller {
             .machine
             .posture()
             .expect("executing implies a sequence");
+        let mut targets = *self.machine.targets();
+        self.hand_press
+            .apply(&mut targets, measurement.wrenches, &self.config, dt);
         self.assembler.assemble(
             &self.robot,
             &self.machine.qp_config(&self.config),
             &self.kinematics,
             &self.configuration,
             &self.last_command,
-            self.machine.targets(),
+            &targets,
             posture,
             dt,
         );

@@ -31,8 +31,9 @@ impl Profile {
     }
 }
 
-/// A pose interpolated from `start` to `goal`: translation on the straight line, rotation about
-/// one fixed world axis.
+/// A pose interpolated from `start` to `goal`: translation on the straight line, raised by an
+/// arc of height `lift` at its middle ([`PoseTrajectory::lifted`]), rotation about one fixed
+/// world axis.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PoseTrajectory {
     start: Isometry3<f64>,
@@ -40,6 +41,7 @@ pub(crate) struct PoseTrajectory {
     rotation_axis_angle: Vector3<f64>,
     duration: f64,
     profile: Profile,
+    lift: f64,
 }
 
 impl PoseTrajectory {
@@ -56,7 +58,15 @@ impl PoseTrajectory {
             rotation_axis_angle: (goal.rotation * start.rotation.inverse()).scaled_axis(),
             duration,
             profile,
+            lift: 0.0,
         }
+    }
+
+    /// The same motion over an arc: `lift` · 4s(1 − s) above the straight line (`lift` at its
+    /// middle), so it ends coming down onto the goal, as a hand onto the top of a railing it
+    /// would otherwise sweep through from below.
+    pub fn lifted(self, lift: f64) -> Self {
+        Self { lift, ..self }
     }
 
     /// A motion that stays at `pose`.
@@ -78,10 +88,11 @@ impl PoseTrajectory {
     pub fn sample(&self, t: f64) -> (Isometry3<f64>, [f64; 6]) {
         let (s, ds) = self.profile.sample(t, self.duration);
         let delta = self.goal.translation.vector - self.start.translation.vector;
-        let translation = self.start.translation.vector + delta * s;
+        let arc = Vector3::z() * self.lift * 4.0;
+        let translation = self.start.translation.vector + delta * s + arc * s * (1.0 - s);
         let rotation =
             UnitQuaternion::from_scaled_axis(self.rotation_axis_angle * s) * self.start.rotation;
-        let v = delta * ds;
+        let v = (delta + arc * (1.0 - 2.0 * s)) * ds;
         let w = self.rotation_axis_angle * ds;
         (
             Isometry3::from_parts(Translation3::from(translation), rotation),
@@ -164,5 +175,25 @@ mod tests {
         assert!(p1.rotation.angle_to(&goal.rotation) < 1e-12);
         assert!(v0.iter().chain(&v1).all(|v| v.abs() < 1e-12));
         assert_velocity_is_derivative(|t| trajectory.sample(t), 0.6);
+    }
+
+    #[test]
+    fn a_lifted_motion_arcs_over_the_straight_line_and_comes_down_onto_the_goal() {
+        let start = Isometry3::translation(0.0, -0.25, 0.77);
+        let goal = Isometry3::translation(0.0, -0.45, 0.86);
+        let trajectory = PoseTrajectory::new(start, goal, 1.0, Profile::MinimumJerk).lifted(0.08);
+        let middle = trajectory.sample(0.5).0.translation.vector;
+        let straight = (start.translation.vector + goal.translation.vector) / 2.0;
+        assert!(
+            (middle - straight - Vector3::z() * 0.08).norm() < 1e-12,
+            "{middle}"
+        );
+        assert!(
+            (trajectory.sample(1.0).0.translation.vector - goal.translation.vector).norm() < 1e-12
+        );
+        // Near its end it moves down onto the goal, from above it.
+        let (near, velocity) = trajectory.sample(0.9);
+        assert!(near.translation.z > goal.translation.z && velocity[2] < 0.0);
+        assert_velocity_is_derivative(|t| trajectory.sample(t), 0.3);
     }
 }

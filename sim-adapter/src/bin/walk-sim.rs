@@ -213,7 +213,7 @@ fn serve_mujoco(
             tracing::info!(
                 scene = scene.name,
                 surfaces = scene.environment.surfaces.len(),
-                railings = scene.railing_radii.len(),
+                railings = scene.environment.hand_affordances.len(),
                 "terrain"
             );
             let initial = terrain.place(&standing);

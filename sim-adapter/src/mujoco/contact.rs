@@ -1,29 +1,32 @@
-//! Foot force-torque readings from MuJoCo's contact forces.
+//! Force-torque readings of the soles and palms from MuJoCo's contact forces.
 //!
-//! Each ankle FT sensor reads the resultant of the floor's contact forces on that foot, as the
-//! wrench the ground exerts on the robot, taken about the configured FT frame origin in
-//! world-aligned axes (the convention of the controller's `Measurement` and of the kinematic
-//! simulator). Read right after the constraint solve, while the contact list, the solved forces
-//! and the body poses all belong to the same state.
+//! Each ankle FT sensor reads the resultant of the environment's contact forces on that foot's
+//! sole, each wrist FT sensor those on that hand's palm, as the wrench the environment exerts on
+//! the robot, taken about the configured FT frame origin in world-aligned axes (the convention of
+//! the controller's `Measurement` and of the kinematic simulator). Read right after the
+//! constraint solve, while the contact list, the solved forces and the body poses all belong to
+//! the same state.
 
+use kinematics::robot::EndEffector;
 use mujoco_rs::prelude::{MjData, MjModel};
 use nalgebra::{Matrix3, Vector3};
 
-/// Contact-derived quantities of both feet (index 0 = left, 1 = right).
+/// Contact-derived quantities of the four end-effectors, in `EndEffector` order (left foot,
+/// right foot, left hand, right hand: `shm_types::WRENCH_ORDER`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct FootContacts {
-    /// (force xyz, torque xyz) of the ground on each foot about its FT frame origin.
-    pub wrenches: [[f64; 6]; 2],
-    /// Whether each foot touches the floor.
-    pub touching: [bool; 2],
-    /// Deepest penetration of a sole into the floor (m, ≥ 0).
+pub(crate) struct Contacts {
+    /// (force xyz, torque xyz) of the environment on each end-effector about its FT frame origin.
+    pub wrenches: [[f64; 6]; 4],
+    /// Whether each end-effector touches anything.
+    pub touching: [bool; 4],
+    /// Deepest penetration of a sole into the terrain (m, ≥ 0).
     pub penetration: f64,
 }
 
-impl FootContacts {
+impl Contacts {
     /// Adds `share` of `reading`, for the mean over a control period's physics steps (touching
     /// in any of them, the deepest penetration).
-    pub fn add(&mut self, reading: &FootContacts, share: f64) {
+    pub fn add(&mut self, reading: &Contacts, share: f64) {
         for (sum, wrench) in self.wrenches.iter_mut().zip(&reading.wrenches) {
             for (s, w) in sum.iter_mut().zip(wrench) {
                 *s += w * share;
@@ -36,41 +39,43 @@ impl FootContacts {
     }
 }
 
-/// MuJoCo ids the contact reading needs.
+/// MuJoCo ids the contact reading needs, in `EndEffector` order.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct FootIds {
-    /// Collision box geom of each foot.
-    pub geoms: [usize; 2],
-    /// FT frame site of each foot.
-    pub ft_sites: [usize; 2],
+pub(crate) struct ContactIds {
+    /// Collision geom of each end-effector: a foot's sole box, a hand's palm sphere.
+    pub geoms: [usize; 4],
+    /// FT frame site of each end-effector (ankle or wrist).
+    pub ft_sites: [usize; 4],
 }
 
-/// Sums the contact forces on each foot into wrenches about its FT frame.
-pub(crate) fn read(data: &MjData<Box<MjModel>>, ids: &FootIds) -> FootContacts {
-    let mut out = FootContacts::default();
+/// Sums the contact forces on each end-effector into wrenches about its FT frame.
+pub(crate) fn read(data: &MjData<Box<MjModel>>, ids: &ContactIds) -> Contacts {
+    let mut out = Contacts::default();
     let sites = data.site_xpos();
     let contacts = data.contact();
     for (index, contact) in contacts.iter().enumerate() {
         let (g1, g2) = (contact.geom[0] as usize, contact.geom[1] as usize);
         // MuJoCo's contact force acts on geom2, from geom1, along the normal pointing from
-        // geom1 to geom2; flip it when the foot is geom1.
-        let (foot, sign) = match ids.geoms.iter().position(|&g| g == g2) {
-            Some(foot) => (foot, 1.0),
+        // geom1 to geom2; flip it when the end-effector is geom1.
+        let (effector, sign) = match ids.geoms.iter().position(|&g| g == g2) {
+            Some(effector) => (effector, 1.0),
             None => match ids.geoms.iter().position(|&g| g == g1) {
-                Some(foot) => (foot, -1.0),
+                Some(effector) => (effector, -1.0),
                 None => continue,
             },
         };
-        out.touching[foot] = true;
-        out.penetration = out.penetration.max(-contact.dist);
+        out.touching[effector] = true;
+        if EndEffector::ALL[effector].is_foot() {
+            out.penetration = out.penetration.max(-contact.dist);
+        }
         let local = data.contact_force(index);
         // Rows of `frame` are the contact axes (normal, tangent 1, tangent 2) in world coordinates.
         let axes = Matrix3::from_row_slice(&contact.frame).transpose();
         let force = axes * Vector3::new(local[0], local[1], local[2]) * sign;
         let torque = axes * Vector3::new(local[3], local[4], local[5]) * sign;
-        let arm = Vector3::from(contact.pos) - Vector3::from(sites[ids.ft_sites[foot]]);
+        let arm = Vector3::from(contact.pos) - Vector3::from(sites[ids.ft_sites[effector]]);
         let moment = torque + arm.cross(&force);
-        let wrench = &mut out.wrenches[foot];
+        let wrench = &mut out.wrenches[effector];
         for k in 0..3 {
             wrench[k] += force[k];
             wrench[k + 3] += moment[k];

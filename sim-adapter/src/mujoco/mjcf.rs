@@ -8,10 +8,13 @@
 //!   damping, and the URDF effort limit as the bound on its actuators' torque (motor
 //!   saturation; a URDF effort of 0 or none leaves it unbounded);
 //! - collision geometry only where contact is meaningful: one box per foot, the configured sole
-//!   rectangle with its bottom face on the sole frame, colliding with the floor and nothing else;
+//!   rectangle with its bottom face on the sole frame, colliding with the ground; one sphere per
+//!   hand, `[robot] palm_radius` around the hand frame, colliding with the railings and the
+//!   ground (a hand that reaches the ground in a fall lands on it);
 //! - with a [`Terrain`], a capsule along each leg bone (below), colliding with the floor and the
 //!   terrain only;
-//! - sites at every end-effector frame, both FT frames and the base (the IMU);
+//! - sites at every end-effector frame, the four FT frames (ankles and wrists) and the base (the
+//!   IMU);
 //! - per joint a position and a velocity actuator (the servo), in model joint order;
 //! - IMU sensors (orientation, gyro, accelerometer) at the base site;
 //! - with `visual_geoms`, what pictures need and the physics ignores ([`visuals`](super::visuals)):
@@ -21,8 +24,9 @@
 //!
 //! Collision classes: the environment's geoms set `contype`, the robot's `conaffinity`, so the
 //! robot never collides with itself. Bit [`GROUND_BIT`]: the floor and the terrain's surfaces
-//! against the soles and the leg capsules. Bit [`RAILING_BIT`]: the railings, against nothing yet
-//! (hands get geometry with the hand issue).
+//! against the soles, the palms and the leg capsules. Bit [`RAILING_BIT`]: the railings, against
+//! the palms. A palm's contact with a railing is friction only (the railing's, 1.0): no grip,
+//! no weld, so a hand carries load by pressing on the rail.
 //!
 //! Leg bones: for each body moved by a `[robot.joint_groups] legs` joint, a capsule from its
 //! origin (the joint) to each child body's origin, [`leg_radius`] thick, hidden in geom group
@@ -47,14 +51,20 @@ use super::visuals::{self, VisualGeom};
 pub(crate) const FREE_JOINT: &str = "floating_base";
 /// Site name of the IMU at the floating base origin (the URDF root link).
 pub(crate) const IMU_SITE: &str = "imu";
-/// Site names of the FT frames (left foot, right foot).
-pub(crate) const FT_SITES: [&str; 2] = ["left_foot_ft", "right_foot_ft"];
-/// Geom names of the foot collision boxes (left, right).
-pub(crate) const FOOT_GEOMS: [&str; 2] = ["left_sole", "right_sole"];
+/// Site names of the FT frames, in `EndEffector` order (ankles, then wrists).
+pub(crate) const FT_SITES: [&str; 4] = [
+    "left_foot_ft",
+    "right_foot_ft",
+    "left_hand_ft",
+    "right_hand_ft",
+];
+/// Geom names of the end-effectors' collision geoms, in `EndEffector` order: the sole boxes,
+/// then the palm spheres.
+pub(crate) const CONTACT_GEOMS: [&str; 4] = ["left_sole", "right_sole", "left_palm", "right_palm"];
 /// Collision bit of the ground: the floor and the terrain's surfaces (`contype`), the soles and
 /// the leg capsules (`conaffinity`).
 pub(crate) const GROUND_BIT: u32 = 1;
-/// Collision bit of the railings (`contype`); no robot geom has it in its `conaffinity` yet.
+/// Collision bit of the railings (`contype`) and the palms (`conaffinity`).
 pub(crate) const RAILING_BIT: u32 = 2;
 /// Geom group of the leg capsules: not drawn (MuJoCo draws groups 0–2 by default).
 pub(crate) const LEG_GROUP: u32 = 3;
@@ -208,6 +218,8 @@ enum AttachmentKind {
     Site(&'static str),
     /// A foot collision box: (name, half extents).
     SoleBox(&'static str, Vector3<f64>),
+    /// A hand collision sphere: (name, radius).
+    Palm(&'static str, f64),
     /// A leg bone's collision capsule from the body origin to `end`, in the body frame (the
     /// attachment pose is unused).
     LegBone {
@@ -241,20 +253,22 @@ impl Attachments {
             });
         }
         let half = Vector3::new(robot.sole.length, robot.sole.width, sole_thickness) / 2.0;
-        let feet = [EndEffector::LeftFoot, EndEffector::RightFoot];
-        for ((foot, geom), (&ft_frame, ft_site)) in feet
+        let ft_frames = robot.ft_sensors.iter().chain(&robot.wrist_ft_sensors);
+        for ((effector, geom), (&ft_frame, ft_site)) in EndEffector::ALL
             .into_iter()
-            .zip(FOOT_GEOMS)
-            .zip(robot.ft_sensors.iter().zip(FT_SITES))
+            .zip(CONTACT_GEOMS)
+            .zip(ft_frames.zip(FT_SITES))
         {
-            let (body, sole) = place_frame(&robot.model, bodies, robot.frame(foot))?;
-            // The box's bottom face lies on the sole plane: its centre is half a thickness above.
-            let pose = sole * Translation3::new(0.0, 0.0, half.z);
-            all.push(Attachment {
-                body,
-                pose,
-                kind: AttachmentKind::SoleBox(geom, half),
-            });
+            let (body, frame) = place_frame(&robot.model, bodies, robot.frame(effector))?;
+            let (pose, kind) = if effector.is_foot() {
+                // The box's bottom face lies on the sole plane: its centre is half a thickness
+                // above.
+                let pose = frame * Translation3::new(0.0, 0.0, half.z);
+                (pose, AttachmentKind::SoleBox(geom, half))
+            } else {
+                (frame, AttachmentKind::Palm(geom, robot.palm_radius))
+            };
+            all.push(Attachment { body, pose, kind });
             let (body, pose) = place_frame(&robot.model, bodies, ft_frame)?;
             all.push(Attachment {
                 body,
@@ -399,6 +413,14 @@ fn write_body(
                     pose_attributes(&attachment.pose)
                 );
             }
+            AttachmentKind::Palm(name, radius) => {
+                let _ = writeln!(
+                    xml,
+                    r#"{pad}  <geom name="{name}" type="sphere" size="{radius}" conaffinity="{}" {}/>"#,
+                    GROUND_BIT | RAILING_BIT,
+                    pose_attributes(&attachment.pose)
+                );
+            }
             AttachmentKind::LegBone {
                 ref name,
                 end,
@@ -513,7 +535,7 @@ mod tests {
     #[test]
     fn without_a_terrain_the_model_is_the_flat_floor_one() {
         // Fingerprints and lengths of the documents written before terrain existed: flat walks
-        // simulate the same model as then.
+        // simulate the same model as then, plus the palms and the wrist FT sites (4 lines).
         for (name, visual_geoms, hash, length) in [
             ("jvrc1", true, 0xf8c7_5ae0_ad90_45b8, 23057),
             ("jvrc1", false, 0x58e2_14e4_fe88_b33c, 18344),
@@ -525,7 +547,14 @@ mod tests {
                 visual_geoms,
                 ..MujocoOptions::default()
             };
-            let xml = write(&robot, &bodies, &options, None).unwrap();
+            let written = write(&robot, &bodies, &options, None).unwrap();
+            let hands = ["left_palm", "right_palm", "left_hand_ft", "right_hand_ft"]
+                .map(|name| format!(r#"name="{name}""#));
+            let (added, kept): (Vec<&str>, Vec<&str>) = written
+                .split_inclusive('\n')
+                .partition(|line| hands.iter().any(|name| line.contains(name.as_str())));
+            assert_eq!(added.len(), 4, "{name}: {added:?}");
+            let xml = kept.concat();
             assert_eq!(
                 (fingerprint(&xml), xml.len()),
                 (hash, length),

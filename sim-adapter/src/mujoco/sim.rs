@@ -14,7 +14,7 @@ use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuat
 use super::actuators::ActuatorRecord;
 use super::bodies::RigidBodies;
 use super::collisions::{CollisionWatch, TerrainCollisions};
-use super::contact::{self, FootContacts, FootIds};
+use super::contact::{self, ContactIds, Contacts};
 use super::mjcf;
 use super::{MujocoError, MujocoOptions, Terrain};
 
@@ -39,7 +39,8 @@ struct Layout {
     base_qpos: usize,
     /// Site of each end-effector frame, by [`EndEffector`].
     effector_sites: [usize; 4],
-    feet: FootIds,
+    /// Collision geom and FT site of each end-effector, by [`EndEffector`].
+    contacts: ContactIds,
     /// The body the robot's `base_link` belongs to, and the link's pose in that body.
     base_link_body: usize,
     base_link_offset: Isometry3<f64>,
@@ -56,7 +57,7 @@ pub struct MujocoSim {
     data: MjData<Box<MjModel>>,
     layout: Layout,
     /// Contact readings of the last constraint solve (or the last `step`'s mean).
-    contacts: FootContacts,
+    contacts: Contacts,
     /// Sole pose of each foot when it last touched down (for the slip metric).
     anchors: [Option<Isometry3<f64>>; 2],
     polygon: SupportPolygon,
@@ -139,7 +140,7 @@ impl MujocoSim {
             options,
             data,
             layout,
-            contacts: FootContacts::default(),
+            contacts: Contacts::default(),
             anchors: [None, None],
             polygon: SupportPolygon::empty(),
             measurement,
@@ -237,7 +238,7 @@ impl MujocoSim {
             ctrl[2 * j + 1] = 0.0;
         }
         self.data.forward();
-        self.contacts = contact::read(&self.data, &self.layout.feet);
+        self.contacts = contact::read(&self.data, &self.layout.contacts);
         self.collisions.observe(&self.data, self.data.time());
         self.record(0);
     }
@@ -296,12 +297,8 @@ impl MujocoSim {
         m.base_orientation =
             UnitQuaternion::from_quaternion(Quaternion::new(imu[0], imu[1], imu[2], imu[3]));
         m.com = Vector3::from(self.data.subtree_com()[self.layout.base_body]);
-        m.wrenches = [[0.0; 6]; 4];
-        m.contacts = [false; 4];
-        for (slot, foot) in FEET.iter().enumerate() {
-            m.wrenches[*foot as usize] = self.contacts.wrenches[slot];
-            m.contacts[*foot as usize] = self.contacts.touching[slot];
-        }
+        m.wrenches = self.contacts.wrenches;
+        m.contacts = self.contacts.touching;
         let safety = self.safety(limit_violations);
         self.measurement.safety = safety;
         let fell = self.has_fallen();
@@ -385,16 +382,14 @@ impl Layout {
             effector_sites[effector as usize] =
                 id(MjtObjBase::mjOBJ_SITE, mjcf::end_effector_site(effector))?;
         }
-        let feet = FootIds {
-            geoms: [
-                id(MjtObjBase::mjOBJ_GEOM, mjcf::FOOT_GEOMS[0])?,
-                id(MjtObjBase::mjOBJ_GEOM, mjcf::FOOT_GEOMS[1])?,
-            ],
-            ft_sites: [
-                id(MjtObjBase::mjOBJ_SITE, mjcf::FT_SITES[0])?,
-                id(MjtObjBase::mjOBJ_SITE, mjcf::FT_SITES[1])?,
-            ],
+        let mut contacts = ContactIds {
+            geoms: [0; 4],
+            ft_sites: [0; 4],
         };
+        for effector in 0..4 {
+            contacts.geoms[effector] = id(MjtObjBase::mjOBJ_GEOM, mjcf::CONTACT_GEOMS[effector])?;
+            contacts.ft_sites[effector] = id(MjtObjBase::mjOBJ_SITE, mjcf::FT_SITES[effector])?;
+        }
         let base_link_name = robot.model.link_name(robot.base_link);
         let base_link = bodies.links.get(base_link_name).ok_or_else(|| {
             MujocoError::ModelMismatch(format!(
@@ -407,7 +402,7 @@ impl Layout {
             base_body,
             base_qpos: qpos_addresses[free] as usize,
             effector_sites,
-            feet,
+            contacts,
             base_link_body: id(MjtObjBase::mjOBJ_BODY, &bodies.bodies[base_link.body].name)?,
             base_link_offset: base_link.offset,
         })
@@ -454,7 +449,7 @@ impl Simulator for MujocoSim {
             ctrl[2 * j + 1] = qd.clamp(-limit.velocity, limit.velocity);
         }
         let warnings_before = self.fatal_warning_count();
-        let mut period = FootContacts::default();
+        let mut period = Contacts::default();
         for substep in 0..substeps {
             // The servo drive ramps its position reference over the command period (a
             // first-order hold) rather than jumping at its start: with kp 1e5 N·m/rad a jump of
@@ -477,10 +472,10 @@ impl Simulator for MujocoSim {
             // The contact list, solved forces and poses still describe the same state here.
             self.collisions.observe(&self.data, time);
             if self.options.average_ft_over_step {
-                let reading = contact::read(&self.data, &self.layout.feet);
+                let reading = contact::read(&self.data, &self.layout.contacts);
                 period.add(&reading, 1.0 / substeps as f64);
             } else if substep + 1 == substeps {
-                self.contacts = contact::read(&self.data, &self.layout.feet);
+                self.contacts = contact::read(&self.data, &self.layout.contacts);
             }
             // Kinematics, collisions and position/velocity sensors of the new state.
             self.data.step1();

@@ -45,15 +45,18 @@ pub struct Terrain {
 
 impl Terrain {
     /// The geometry of `scene`. A scene read by `Scene::from_path` always converts; a scene built
-    /// by hand is refused if a surface is not a rectangle centred on its frame, or the railings
-    /// and their radii do not pair up.
+    /// by hand is refused if a surface is not a rectangle centred on its frame, or a railing has
+    /// no radius (a capsule needs one > 0).
     pub fn from_scene(scene: &Scene) -> Result<Self, MujocoError> {
         let environment = &scene.environment;
-        if environment.hand_affordances.len() != scene.railing_radii.len() {
+        if let Some(railing) = environment
+            .hand_affordances
+            .iter()
+            .find(|r| r.radius <= 0.0)
+        {
             return Err(MujocoError::BadTerrain(format!(
-                "{} railings but {} railing radii",
-                environment.hand_affordances.len(),
-                scene.railing_radii.len()
+                "railing \"{}\" has radius {} m, a capsule needs one > 0",
+                railing.name, railing.radius
             )));
         }
         let rectangles = environment
@@ -140,12 +143,11 @@ impl Terrain {
 
     /// The railings, each with its radius (a capsule along its segment), in the scene's order.
     pub(crate) fn railings(&self) -> impl Iterator<Item = (&HandAffordance, f64)> {
-        let scene = &self.scene;
-        scene
+        self.scene
             .environment
             .hand_affordances
             .iter()
-            .zip(scene.railing_radii.iter().copied())
+            .map(|railing| (railing, railing.radius))
     }
 }
 

@@ -155,6 +155,7 @@ pub fn generate_with_railing(
             name: "railing".to_owned(),
             start,
             end,
+            radius: 0.0,
             available,
         });
     }

@@ -210,6 +210,7 @@ fn environment(
         name: "railing".to_owned(),
         start: at(-0.5),
         end: at(options.distance + 0.5),
+        radius: 0.0,
         available: options.railing.unwrap_or([0.0, options.distance]),
     });
     environment

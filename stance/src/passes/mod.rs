@@ -1,9 +1,11 @@
-//! Algorithm 1: the nine post-processing passes (DESIGN.md §4) and the terrain pass that puts
-//! the walk on its surfaces (DESIGN.md §11), each a function on a [`PoseSequence`], and
-//! [`run_passes`], which composes them in the paper's order with the terrain pass after pass 8.
+//! Algorithm 1: the nine post-processing passes (DESIGN.md §4), the terrain pass that puts
+//! the walk on its surfaces (DESIGN.md §11) and the pass that puts held hands on the railings,
+//! each a function on a [`PoseSequence`], and [`run_passes`], which composes them in the paper's
+//! order with the terrain and hand passes after pass 8.
 
 mod contacts;
 mod elevation;
+mod hands;
 mod height;
 mod orientation;
 mod path;
@@ -13,19 +15,21 @@ use std::sync::LazyLock;
 
 pub use contacts::unify_contacts;
 pub use elevation::{contact_feet_to_surface_elevation, move_stances_up};
+pub use hands::hold_hand_affordances;
 pub use height::limit_swing_foot_height;
 pub use orientation::{contact_feet_parallel_to_surface, limit_swing_foot_rotation};
 pub use path::{limit_orthogonal_feet_distance, limit_to_max_step_size, scale_translation};
 pub use terrain::{HEEL_MARGIN_M, SHORT_SURFACE_SOLES, TOE_MARGIN_M, place_on_terrain};
 
-use kinematics::robot::SoleRectangle;
+use kinematics::robot::{Robot, SoleRectangle};
 
 use crate::environment::Environment;
 use crate::geometry::PathFrame;
 use crate::params::PostProcessParams;
 use crate::poses::{FEET, PoseSequence};
 
-/// The passes in execution order: Algorithm 1's (lines 2–10) with the terrain pass after line 9.
+/// The passes in execution order: Algorithm 1's (lines 2–10) with the terrain pass and the hand
+/// pass after line 9.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Pass {
     /// Line 2, [`move_stances_up`].
@@ -46,13 +50,15 @@ pub enum Pass {
     LimitOrthogonalFeetDistance,
     /// Not in Algorithm 1: [`place_on_terrain`].
     PlaceOnTerrain,
+    /// Not in Algorithm 1: [`hold_hand_affordances`].
+    HoldHandAffordances,
     /// Line 10, [`limit_swing_foot_height`].
     LimitSwingFootHeight,
 }
 
 impl Pass {
     /// All passes in order.
-    pub const ALL: [Pass; 10] = [
+    pub const ALL: [Pass; 11] = [
         Pass::MoveStancesUp,
         Pass::UnifyContacts,
         Pass::ContactFeetParallelToSurface,
@@ -62,10 +68,11 @@ impl Pass {
         Pass::LimitToMaxStepSize,
         Pass::LimitOrthogonalFeetDistance,
         Pass::PlaceOnTerrain,
+        Pass::HoldHandAffordances,
         Pass::LimitSwingFootHeight,
     ];
 
-    /// The paper's name of the pass (ours for the terrain pass).
+    /// The paper's name of the pass (ours for the terrain and hand passes).
     pub fn name(self) -> &'static str {
         match self {
             Pass::MoveStancesUp => "moveStancesUp",
@@ -77,15 +84,16 @@ impl Pass {
             Pass::LimitToMaxStepSize => "limitToMaxStepSize",
             Pass::LimitOrthogonalFeetDistance => "limitOrthogonalFeetDistance",
             Pass::PlaceOnTerrain => "placeOnTerrain",
+            Pass::HoldHandAffordances => "holdHandAffordances",
             Pass::LimitSwingFootHeight => "limitSwingFootHeight",
         }
     }
 
-    /// Line of Algorithm 1 that runs the pass; `None` for the terrain pass, which the paper
-    /// does not have.
+    /// Line of Algorithm 1 that runs the pass; `None` for the terrain and hand passes, which
+    /// the paper does not have.
     pub fn line(self) -> Option<usize> {
         match self {
-            Pass::PlaceOnTerrain => None,
+            Pass::PlaceOnTerrain | Pass::HoldHandAffordances => None,
             Pass::LimitSwingFootHeight => Some(10),
             earlier => Some(earlier as usize + 2),
         }
@@ -93,10 +101,10 @@ impl Pass {
 
     /// The environment the pass works in, so its result lies on: the flat ground the raw walk
     /// was generated on (the plane z = 0 through its start) before the terrain pass, `walk`
-    /// (the sequence's own) from it on.
+    /// (the sequence's own, its railings included) from it on.
     pub fn environment(self, walk: &Environment) -> &Environment {
         match self {
-            Pass::PlaceOnTerrain | Pass::LimitSwingFootHeight => walk,
+            Pass::PlaceOnTerrain | Pass::HoldHandAffordances | Pass::LimitSwingFootHeight => walk,
             _ => flat_ground(),
         }
     }
@@ -122,16 +130,37 @@ pub fn path_of(poses: &PoseSequence) -> Option<PathFrame> {
     Some(PathFrame::of_walk(&origin, contact_feet))
 }
 
+/// The sizes of the robot's contact geometry that the passes need: a foot's sole fits on its
+/// surface (terrain pass) and clears the edges it swings over (pass 9); a held palm rests on
+/// top of its railing (hand pass).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactGeometry {
+    /// The sole rectangle of each foot.
+    pub sole: SoleRectangle,
+    /// Radius (m) of the sphere centred on each hand frame, the hand's collision geometry.
+    pub palm_radius: f64,
+}
+
+impl ContactGeometry {
+    /// The robot's sole and palm.
+    pub fn of(robot: &Robot) -> Self {
+        Self {
+            sole: robot.sole,
+            palm_radius: robot.palm_radius,
+        }
+    }
+}
+
 /// Runs the passes in order on `poses`, a walk generated on the flat ground at the origin and
-/// meant for `environment` (in the walk's frame); `sole` is the robot's. Allocation-free (after
-/// the first call).
+/// meant for `environment` (in the walk's frame); `contact` is the robot's. Allocation-free
+/// (after the first call).
 pub fn run_passes(
     poses: &mut PoseSequence,
     environment: &Environment,
     params: &PostProcessParams,
-    sole: &SoleRectangle,
+    contact: &ContactGeometry,
 ) {
-    run_passes_observed(poses, environment, params, sole, |_, _| {});
+    run_passes_observed(poses, environment, params, contact, |_, _| {});
 }
 
 /// [`run_passes`], calling `after` with each pass and the poses it produced (for Fig. 3).
@@ -139,9 +168,10 @@ pub fn run_passes_observed(
     poses: &mut PoseSequence,
     environment: &Environment,
     params: &PostProcessParams,
-    sole: &SoleRectangle,
+    contact: &ContactGeometry,
     mut after: impl FnMut(Pass, &PoseSequence),
 ) {
+    let sole = &contact.sole;
     if poses.is_empty() {
         return;
     }
@@ -166,6 +196,8 @@ pub fn run_passes_observed(
     after(Pass::LimitOrthogonalFeetDistance, poses);
     place_on_terrain(poses, environment, sole, params.s_max);
     after(Pass::PlaceOnTerrain, poses);
+    hold_hand_affordances(poses, environment, contact.palm_radius);
+    after(Pass::HoldHandAffordances, poses);
     limit_swing_foot_height(poses, environment, sole.length, params.h_min, params.h_max);
     after(Pass::LimitSwingFootHeight, poses);
 }
@@ -176,6 +208,7 @@ pub(crate) mod fixtures {
     use kinematics::robot::{EndEffector, SoleRectangle};
     use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
+    use super::ContactGeometry;
     use crate::environment::SupportSurface;
     use crate::geometry::PathFrame;
     use crate::poses::PoseSequence;
@@ -184,6 +217,12 @@ pub(crate) mod fixtures {
     pub const SOLE: SoleRectangle = SoleRectangle {
         length: 0.2,
         width: 0.08,
+    };
+
+    /// JVRC-1's sole and palm.
+    pub const CONTACT: ContactGeometry = ContactGeometry {
+        sole: SOLE,
+        palm_radius: 0.04,
     };
 
     /// A walking path along +x from the origin.
@@ -245,7 +284,7 @@ pub(crate) mod fixtures {
 
 #[cfg(test)]
 mod tests {
-    use super::fixtures::{BOTH, SOLE, block, rotated, stance, walk};
+    use super::fixtures::{BOTH, CONTACT, block, rotated, stance, walk};
     use super::*;
     use crate::geometry::roll_pitch_yaw;
     use crate::params::ContactUnification;
@@ -271,7 +310,7 @@ mod tests {
     fn single_stance_sequence_is_made_executable() {
         let mut p = walk(&[stance([0.0, 0.05, -0.2], [0.0, -0.05, -0.17], BOTH)]);
         rotated(&mut p, 0, LeftFoot, [0.2, 0.1, 0.3]);
-        run_passes(&mut p, &Environment::default(), &params(), &SOLE);
+        run_passes(&mut p, &Environment::default(), &params(), &CONTACT);
         for foot in [LeftFoot, RightFoot] {
             let pose = p.pose(0, foot);
             let [roll, pitch, _] = roll_pitch_yaw(&pose.rotation);
@@ -294,12 +333,16 @@ mod tests {
             &mut p,
             &Environment::default(),
             &params(),
-            &SOLE,
+            &CONTACT,
             |pass, _| seen.push(pass),
         );
         assert_eq!(seen, Pass::ALL);
         let terrain = Pass::ALL.iter().position(|&p| p == Pass::PlaceOnTerrain);
         assert_eq!(terrain, Some(8), "after pass 8, before pass 9");
+        let hands = Pass::ALL
+            .iter()
+            .position(|&p| p == Pass::HoldHandAffordances);
+        assert_eq!(hands, Some(9), "after the terrain pass, before pass 9");
     }
 
     /// Passes 1–5 work on the flat ground whatever the walk's environment: the walk is
@@ -311,7 +354,7 @@ mod tests {
             hand_affordances: Vec::new(),
         };
         let mut p = walk(&[stance([0.0, 0.1, -0.2], [0.0, -0.1, -0.2], BOTH)]);
-        run_passes_observed(&mut p, &env, &params(), &SOLE, |pass, poses| {
+        run_passes_observed(&mut p, &env, &params(), &CONTACT, |pass, poses| {
             let z = poses.pose(0, LeftFoot).translation.z;
             let expected = if pass.environment(&env) == &env {
                 0.1

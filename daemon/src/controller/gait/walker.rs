@@ -561,7 +561,8 @@ impl DynamicWalker {
             } else if !self.targets.contacts[h] && contacts[h] {
                 let goal = self.to_world * targets[h];
                 let reach =
-                    PoseTrajectory::new(feedback.poses[h], goal, duration, Profile::MinimumJerk);
+                    PoseTrajectory::new(feedback.poses[h], goal, duration, Profile::MinimumJerk)
+                        .lifted(self.config.hand_approach_height_m);
                 self.reaches[k] = Some((reach, start));
             }
         }

@@ -1,0 +1,82 @@
+//! How much of the robot's weight its held hands carried: `hand_support_share`, from the
+//! simulator's contact forces (never from the controller's estimate).
+
+use kinematics::robot::EndEffector;
+use shm_types::SimTruth;
+
+use super::truth::state_at;
+
+const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
+
+/// The mean vertical force of the environment on both palms, divided by the robot's weight
+/// (`weight_n`), over the statuses at which a hand is planned in contact and the simulator's
+/// state pairs. Each status is its stance index (the stance the daemon moved towards, into
+/// `contacts`, the sequence's contact flags per stance) and the time it was written. A hand is
+/// planned in contact while the walk moves towards a stance that holds it from one that held it
+/// too: a hand reaching for the rail is not yet meant to carry. `None` when no paired status
+/// plans a hand in contact.
+pub(crate) fn support_share(
+    contacts: &[[bool; 4]],
+    statuses: impl IntoIterator<Item = (u32, u64)>,
+    states: &[SimTruth],
+    weight_n: f64,
+) -> Option<f64> {
+    let last = contacts.len().checked_sub(1)?;
+    let held = |i: usize| {
+        let (now, before) = (
+            contacts[i.min(last)],
+            contacts[i.saturating_sub(1).min(last)],
+        );
+        HANDS.iter().any(|&h| now[h as usize] && before[h as usize])
+    };
+    let (mut sum, mut count) = (0.0, 0_usize);
+    for (index, time) in statuses {
+        if !held(index as usize) {
+            continue;
+        }
+        let Some(state) = state_at(states, time) else {
+            continue;
+        };
+        sum += state.hand_forces.iter().map(|force| force[2]).sum::<f64>();
+        count += 1;
+    }
+    (count > 0).then(|| sum / count as f64 / weight_n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(seq: u64, right_hand_z: f64) -> SimTruth {
+        SimTruth {
+            seq,
+            timestamp_ns: seq * 1000,
+            hand_forces: [[0.0; 3], [0.0, 0.0, right_hand_z]],
+            ..SimTruth::ZERO
+        }
+    }
+
+    #[test]
+    fn the_share_averages_the_palm_forces_while_a_hand_is_held_through_a_transition() {
+        let feet = [true, true, false, false];
+        let held = [true, true, false, true];
+        // Stance 1 grasps, stance 2 holds on, stance 3 lets go.
+        let contacts = [feet, held, held, feet];
+        let states: Vec<_> = (1..=4).map(|seq| state(seq, 100.0 * seq as f64)).collect();
+        // Towards stance 1 (reaching): not counted; towards 2: 200 N and 300 N; towards 3: no.
+        let statuses = [(1, 1000), (2, 2000), (2, 3000), (3, 4000)];
+        let share = support_share(&contacts, statuses, &states, 1000.0).unwrap();
+        assert!((share - 0.25).abs() < 1e-12, "{share}");
+    }
+
+    #[test]
+    fn without_a_held_hand_there_is_no_share() {
+        let feet = [true, true, false, false];
+        let states = [state(1, 50.0)];
+        assert_eq!(
+            support_share(&[feet, feet], [(1, 1000)], &states, 1000.0),
+            None
+        );
+        assert_eq!(support_share(&[], [(1, 1000)], &states, 1000.0), None);
+    }
+}

@@ -1,0 +1,142 @@
+//! Held hands press on their support with a bounded force: admittance on each held hand's
+//! target along the vertical.
+//!
+//! A hand on a rigid railing under stiff position control is a very stiff spring: in MuJoCo a
+//! JVRC-1 palm target one millimetre below a rail's top pushes 167 N into it, enough to lift a
+//! foot off the ground. So a held hand's pose target is not where the plan put it but that pose
+//! moved along the vertical by an offset `o` that integrates the force error,
+//!
+//! ```text
+//! ȯ = hand_admittance · (f_z − hand_force_n),  |ȯ| ≤ hand_press_speed,  |o| ≤ hand_press_depth_m,
+//! ```
+//!
+//! with `f_z` the vertical force of the environment on the hand measured at its wrist (upward
+//! positive): pressing harder than asked raises the target, softer lowers it. A hand that finds
+//! nothing sinks `hand_press_depth_m` below its planned pose at most and presses on nothing, so
+//! the walk goes on without it. The offset of a hand that is not held returns to zero at once.
+//!
+//! Pure and allocation-free: the controller applies it to each tick's targets just before the QP.
+
+use kinematics::robot::EndEffector;
+
+use super::config::ControllerConfig;
+use super::machine::Targets;
+
+const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
+
+/// The held hands' vertical target offsets (see the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct HandPress {
+    offsets: [f64; 2],
+}
+
+impl HandPress {
+    /// Advances each held hand's offset by `dt` from its wrist's vertical force in `wrenches`
+    /// (`EndEffector` order) and moves its pose task in `targets` by it; a hand without a held
+    /// pose task (free, reaching, carried) gets no offset.
+    pub fn apply(
+        &mut self,
+        targets: &mut Targets,
+        wrenches: &[[f64; 6]; 4],
+        config: &ControllerConfig,
+        dt: f64,
+    ) {
+        for (offset, hand) in self.offsets.iter_mut().zip(HANDS) {
+            let h = hand as usize;
+            let (true, Some(task)) = (targets.contacts[h], targets.end_effectors[h].as_mut())
+            else {
+                *offset = 0.0;
+                continue;
+            };
+            let speed = config.hand_admittance * (wrenches[h][2] - config.hand_force_n);
+            let step = speed.clamp(-config.hand_press_speed, config.hand_press_speed) * dt;
+            let depth = config.hand_press_depth_m;
+            *offset = (*offset + step).clamp(-depth, depth);
+            task.pose.translation.vector.z += *offset;
+        }
+    }
+
+    /// The current offsets (m; left hand, right hand).
+    #[cfg(test)]
+    pub fn offsets(&self) -> [f64; 2] {
+        self.offsets
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Isometry3;
+
+    use super::*;
+    use crate::controller::machine::PoseTarget;
+
+    fn held_right_hand() -> Targets {
+        let mut targets = Targets::none();
+        targets.contacts = [true, true, false, true];
+        targets.end_effectors[3] = Some(PoseTarget {
+            pose: Isometry3::translation(0.0, -0.45, 0.86),
+            velocity: [0.0; 6],
+        });
+        targets
+    }
+
+    fn wrench(right_hand_z: f64) -> [[f64; 6]; 4] {
+        let mut wrenches = [[0.0; 6]; 4];
+        wrenches[3][2] = right_hand_z;
+        wrenches
+    }
+
+    #[test]
+    fn a_hand_pressing_too_hard_rises_and_one_pressing_too_softly_sinks_no_faster_than_the_bound() {
+        let config = ControllerConfig::default();
+        let dt = 0.002;
+        let mut press = HandPress::default();
+        // 110 N against 10 N asked: 5e-4 × 100 = 0.05 m/s, the speed bound.
+        let mut targets = held_right_hand();
+        press.apply(&mut targets, &wrench(110.0), &config, dt);
+        let z = targets.end_effectors[3].unwrap().pose.translation.z;
+        assert!((z - (0.86 + 0.05 * dt)).abs() < 1e-12, "{z}");
+        // 2000 N: still the speed bound.
+        let mut targets = held_right_hand();
+        press.apply(&mut targets, &wrench(2000.0), &config, dt);
+        assert!((press.offsets()[1] - 2.0 * 0.05 * dt).abs() < 1e-12);
+        // Nothing under the hand: it sinks, at most hand_press_depth_m.
+        for _ in 0..10_000 {
+            let mut targets = held_right_hand();
+            press.apply(&mut targets, &wrench(0.0), &config, dt);
+        }
+        assert_eq!(press.offsets(), [0.0, -config.hand_press_depth_m]);
+    }
+
+    #[test]
+    fn the_offset_settles_where_the_hand_presses_with_the_asked_force() {
+        // A rail whose top is 1 mm into the planned palm pose (170 N) with a stiffness of
+        // 1.7e5 N/m (JVRC-1's arm in MuJoCo): the offset settles where the spring gives
+        // hand_force_n.
+        let (config, dt, stiffness) = (ControllerConfig::default(), 0.002, 1.7e5);
+        let mut press = HandPress::default();
+        let mut force = 0.0;
+        for _ in 0..5000 {
+            let mut targets = held_right_hand();
+            press.apply(&mut targets, &wrench(force), &config, dt);
+            let palm = targets.end_effectors[3].unwrap().pose.translation.z;
+            let penetration = 0.86 + 0.001 - palm;
+            force = (stiffness * penetration).max(0.0);
+        }
+        assert!((force - config.hand_force_n).abs() < 0.1, "{force}");
+    }
+
+    #[test]
+    fn a_hand_that_is_not_held_has_no_offset() {
+        let config = ControllerConfig::default();
+        let mut press = HandPress::default();
+        let mut targets = held_right_hand();
+        press.apply(&mut targets, &wrench(0.0), &config, 0.002);
+        assert!(press.offsets()[1] < 0.0);
+        targets.contacts[3] = false;
+        let before = targets.end_effectors[3];
+        press.apply(&mut targets, &wrench(0.0), &config, 0.002);
+        assert_eq!(press.offsets(), [0.0, 0.0]);
+        assert_eq!(targets.end_effectors[3].unwrap().pose, before.unwrap().pose);
+    }
+}
