@@ -605,7 +605,10 @@ mod tests {
         assert_eq!(offset_of!(SimTruth, terrain_collisions), after_actuators);
         let after_count = after_actuators + size_of::<u64>();
         assert_eq!(offset_of!(SimTruth, hand_forces), after_count);
-        assert_eq!(size_of::<SimTruth>(), after_count + size_of::<[[f64; 3]; 2]>());
+        assert_eq!(
+            size_of::<SimTruth>(),
+            after_count + size_of::<[[f64; 3]; 2]>()
+        );
     }
 
     #[test]
