@@ -65,6 +65,9 @@ impl EndEffector {
         EndEffector::RightHand,
     ];
 
+    /// The hands, left then right.
+    pub const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
+
     /// The config key and frame name (`left_foot`, `right_foot`, `left_hand`, `right_hand`).
     pub fn name(self) -> &'static str {
         match self {
@@ -398,26 +401,25 @@ impl Loader<'_> {
                 &section.ft_sensors.right,
             )?,
         ];
+        // A wrist sensor not configured is the origin of the hand frame's link.
+        let wrist = |hand: &FrameSpec| FrameSpec {
+            link: hand.link.clone(),
+            translation: [0.0; 3],
+            rpy: [0.0; 3],
+        };
         let ft = &section.ft_sensors;
-        let mut wrist_ft_sensors = [FrameId(0); 2];
-        for (i, (slot, spec)) in wrist_ft_sensors
-            .iter_mut()
-            .zip([&ft.left_hand, &ft.right_hand])
-            .enumerate()
-        {
-            let hand = [&frames.left_hand, &frames.right_hand][i];
-            let wrist = FrameSpec {
-                link: hand.link.clone(),
-                translation: [0.0; 3],
-                rpy: [0.0; 3],
-            };
-            let key = ["ft_sensors.left_hand", "ft_sensors.right_hand"][i];
-            *slot = self.frame(
-                key,
-                WRIST_FT_SENSOR_FRAMES[i],
-                spec.as_ref().unwrap_or(&wrist),
-            )?;
-        }
+        let wrist_ft_sensors = [
+            self.frame(
+                "ft_sensors.left_hand",
+                WRIST_FT_SENSOR_FRAMES[0],
+                ft.left_hand.as_ref().unwrap_or(&wrist(&frames.left_hand)),
+            )?,
+            self.frame(
+                "ft_sensors.right_hand",
+                WRIST_FT_SENSOR_FRAMES[1],
+                ft.right_hand.as_ref().unwrap_or(&wrist(&frames.right_hand)),
+            )?,
+        ];
         // The default follows the sole, within the range a configured value must keep.
         let palm_radius = section.palm_radius.unwrap_or_else(|| {
             (PALM_RADIUS_PER_SOLE_WIDTH * section.sole.width)

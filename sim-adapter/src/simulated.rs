@@ -84,11 +84,7 @@ impl<S: Simulator + MotorLoad + TerrainContacts> GroundTruth for SimulatedRobot<
         out.actuators = sim.actuator_load();
         out.terrain_collisions = sim.terrain_collision_count();
         let wrenches = &sim.measurement().wrenches;
-        for (force, hand) in out
-            .hand_forces
-            .iter_mut()
-            .zip([EndEffector::LeftHand, EndEffector::RightHand])
-        {
+        for (force, hand) in out.hand_forces.iter_mut().zip(EndEffector::HANDS) {
             force.copy_from_slice(&wrenches[hand as usize][..3]);
         }
     }

@@ -9,7 +9,7 @@ use nalgebra::{Isometry3, Vector3};
 pub const FEET: [EndEffector; 2] = [EndEffector::LeftFoot, EndEffector::RightFoot];
 
 /// The two hands, in the order of the `[left, right]` arrays the passes use.
-pub const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
+pub const HANDS: [EndEffector; 2] = EndEffector::HANDS;
 
 /// World-frame poses of a sequence: `roots[i]`, `end_effectors[i][e as usize]`, `contacts[i]`.
 #[derive(Clone, Debug, Default, PartialEq)]

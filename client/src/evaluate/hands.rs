@@ -6,8 +6,6 @@ use shm_types::SimTruth;
 
 use super::truth::state_at;
 
-const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
-
 /// The mean vertical force of the environment on both palms, divided by the robot's weight
 /// (`weight_n`), over the statuses at which a hand is planned in contact and the simulator's
 /// state pairs. Each status is its stance index (the stance the daemon moved towards, into
@@ -27,7 +25,9 @@ pub(crate) fn support_share(
             contacts[i.min(last)],
             contacts[i.saturating_sub(1).min(last)],
         );
-        HANDS.iter().any(|&h| now[h as usize] && before[h as usize])
+        EndEffector::HANDS
+            .iter()
+            .any(|&h| now[h as usize] && before[h as usize])
     };
     let (mut sum, mut count) = (0.0, 0_usize);
     for (index, time) in statuses {

@@ -5,10 +5,11 @@
 //! controller turns the world anchors about the vertical so the estimate's yaw follows the IMU's
 //! ([`BaseEstimator::heading_error`]), which catches the feet turning together on the ground,
 //! the one motion leg odometry cannot see. Roll and pitch come from the anchored feet: the QP
-//! holds those feet at their anchors, and an estimate that saw a stance foot tipped (the IMU's view when a compliant foot rolls a little on its edge) would
-//! make the anchor correction turn the joints to flatten the foot, which rolls the robot further
-//! the same way. Measured under MuJoCo: with the IMU orientation JVRC-1 toppled in 3 of 3 5 m
-//! walks, with leg odometry alone it finished all three.
+//! holds those feet at their anchors, and an estimate that saw a stance foot tipped (the IMU's
+//! view when a compliant foot rolls a little on its edge) would make the anchor correction turn
+//! the joints to flatten the foot, which rolls the robot further the same way. Measured under
+//! MuJoCo: with the IMU orientation JVRC-1 toppled in 3 of 3 5 m walks, with leg odometry alone
+//! it finished all three.
 
 use kinematics::configuration::Configuration;
 use kinematics::kinematics::Kinematics;

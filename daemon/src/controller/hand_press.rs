@@ -22,8 +22,6 @@ use kinematics::robot::EndEffector;
 use super::config::ControllerConfig;
 use super::machine::Targets;
 
-const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
-
 /// The held hands' vertical target offsets (see the module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct HandPress {
@@ -41,7 +39,7 @@ impl HandPress {
         config: &ControllerConfig,
         dt: f64,
     ) {
-        for (offset, hand) in self.offsets.iter_mut().zip(HANDS) {
+        for (offset, hand) in self.offsets.iter_mut().zip(EndEffector::HANDS) {
             let h = hand as usize;
             let (true, Some(task)) = (targets.contacts[h], targets.end_effectors[h].as_mut())
             else {

@@ -378,7 +378,7 @@ impl StateMachine {
     fn begin_transition(&mut self, feedback: &Feedback) {
         let next = self.sequence().stances[self.stance].contacts;
         let is_last = self.stance + 1 == self.sequence().len();
-        for hand in [EndEffector::LeftHand, EndEffector::RightHand] {
+        for hand in EndEffector::HANDS {
             let h = hand as usize;
             if !next[h] && self.targets.contacts[h] {
                 self.targets.contacts[h] = false;

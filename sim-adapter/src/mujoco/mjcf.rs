@@ -61,8 +61,8 @@ pub(crate) const FT_SITES: [&str; 4] = [
 /// Geom names of the end-effectors' collision geoms, in `EndEffector` order: the sole boxes,
 /// then the palm spheres.
 pub(crate) const CONTACT_GEOMS: [&str; 4] = ["left_sole", "right_sole", "left_palm", "right_palm"];
-/// Collision bit of the ground: the floor and the terrain's surfaces (`contype`), the soles and
-/// the leg capsules (`conaffinity`).
+/// Collision bit of the ground: the floor and the terrain's surfaces (`contype`), the soles, the
+/// palms and the leg capsules (`conaffinity`).
 pub(crate) const GROUND_BIT: u32 = 1;
 /// Collision bit of the railings (`contype`) and the palms (`conaffinity`).
 pub(crate) const RAILING_BIT: u32 = 2;

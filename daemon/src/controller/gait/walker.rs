@@ -54,8 +54,6 @@ use crate::controller::sequencer::on_both_feet;
 use crate::controller::status::{BalanceStatus, FaultCode, Phase};
 use crate::controller::trajectory::{PoseTrajectory, Profile};
 
-const HANDS: [EndEffector; 2] = [EndEffector::LeftHand, EndEffector::RightHand];
-
 /// How far above its foothold's height a swing sole may be and still count as landed when no
 /// force-torque confirms it (m): the ground stops a foot commanded below it within this.
 const LANDING_HEIGHT_TOLERANCE_M: f64 = 0.015;
@@ -550,7 +548,7 @@ impl DynamicWalker {
         let duration = phases[transition.phases.end - 1].end_s() - start;
         let stance = &self.sequence.as_ref().expect("loaded").stances[transition.stance];
         let (contacts, targets) = (stance.contacts, stance.targets);
-        for (k, hand) in HANDS.iter().enumerate() {
+        for (k, hand) in EndEffector::HANDS.iter().enumerate() {
             let h = *hand as usize;
             if self.targets.contacts[h] && !contacts[h] {
                 self.targets.contacts[h] = false;
@@ -570,7 +568,7 @@ impl DynamicWalker {
 
     /// The hands that reached are in contact.
     fn finish_transition(&mut self) {
-        for (k, hand) in HANDS.iter().enumerate() {
+        for (k, hand) in EndEffector::HANDS.iter().enumerate() {
             if let Some((reach, _)) = self.reaches[k].take() {
                 let h = *hand as usize;
                 self.targets.contacts[h] = true;
@@ -754,7 +752,7 @@ impl DynamicWalker {
             }
             self.targets.end_effectors[swing.foot as usize] = Some(PoseTarget { pose, velocity });
         }
-        for (k, hand) in HANDS.iter().enumerate() {
+        for (k, hand) in EndEffector::HANDS.iter().enumerate() {
             let h = *hand as usize;
             self.targets.end_effectors[h] = if self.targets.contacts[h] {
                 Some(PoseTarget {
