@@ -227,6 +227,7 @@ fn bench_sequence(
                 distance,
                 affordances: args.affordances,
                 seed: args.seed,
+                speed: None,
             };
             let generated = sequence::generated(robot, &params, &source, &request)?;
             let origin = format!(

@@ -42,6 +42,7 @@ fn learned_sequence(
         distance,
         affordances,
         seed,
+        speed: None,
     };
     sequence::generated(&robot, &params(robot_name), &source, &request)
         .expect("learned sequence is generated and post-processed")
@@ -134,9 +135,10 @@ fn sequence_files_read_back_as_generated() {
         distance: 1.0,
         affordances: AffordanceSet::FeetLeftHand,
         seed: 1,
+        speed: None,
     };
     let options = request.generate_options(&params("jvrc1"));
-    let raw = source.generate(&robot, &options, None).unwrap().raw;
+    let raw = source.generate(&robot, &options, None, None).unwrap().raw;
     let expected = learned_sequence("jvrc1", AffordanceSet::FeetLeftHand, 1.0, None, 1);
 
     let (raw_path, processed_path) = (scratch("raw.json"), scratch("pp.json"));

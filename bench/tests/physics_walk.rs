@@ -57,6 +57,7 @@ mod walks {
             distance,
             affordances,
             seed: 0,
+            speed: None,
         };
         let report = walk_distance(&config(robot), None, &request, &options)
             .unwrap_or_else(|e| panic!("{robot} {}: {e:#}", affordances.name()));
@@ -199,6 +200,7 @@ mod walks {
                 distance: 1.0,
                 affordances,
                 seed: 0,
+                speed: None,
             };
             let sequence =
                 walk_bench::sequence::generated(&robot_model, &params, &source, &request)

@@ -1,13 +1,15 @@
 //! The dynamic gait against the kinematic simulator judging by the ZMP: the walking pattern keeps
 //! the ZMP of the commanded motion inside the support (JVRC-1; ARMAR-4 its reference ZMP, the
 //! commanded one most of the time), a generated JVRC-1 walk reaches `done` at 1 kHz through its
-//! touchdowns, phases and balance readings are reported, a missing touchdown faults, and a robot
-//! without `[gait.dynamic]` refuses the walk.
+//! touchdowns, phases and balance readings are reported, a missing touchdown faults, a robot
+//! without `[gait.dynamic]` refuses the walk, a version-1 stance file still walks, and a paced
+//! learned walk is planned from its stance durations.
 
 mod walk_support;
 
 use daemon::controller::{
-    Controller, ControllerState, FaultCode, Gait, GaitConfig, MeasurementFault, Phase, Refusal,
+    Controller, ControllerState, FaultCode, Gait, GaitConfig, MeasurementFault, Phase, PhaseTiming,
+    Refusal,
 };
 use kinematic_sim::Simulator;
 use kinematics::ground::{SupportPolygon, sole_corners};
@@ -311,4 +313,82 @@ fn a_robot_without_a_dynamic_gait_refuses_a_dynamic_walk() {
     )
     .expect("static walk accepted");
     assert_eq!(prepared.gait(), Gait::Static);
+}
+
+/// A stance file of format version 1 (written before stances had durations; the flat JVRC-1
+/// walk of `stance/tests/data`) still loads, and the dynamic gait walks it on the config's
+/// timing.
+#[test]
+fn a_version_1_stance_file_still_walks() {
+    let mut h = Harness::dynamic("jvrc1", 500.0);
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../stance/tests/data/flat-jvrc1-dynamic-1.5m-seed5.json"
+    );
+    let text = std::fs::read_to_string(path).expect("the stored file reads");
+    assert!(text.contains("\"format_version\": 1"));
+    let sequence = stance::PostProcessedSequence::from_json_str(&text, &h.robot).expect("loads");
+    h.start_dynamic(&sequence, &kinematic_gait_config("jvrc1"));
+    let mut timings = Vec::new();
+    run(&mut h, 30_000, |h| {
+        let planned = h.closed.controller.status().balance.planned_phase;
+        timings.extend(planned.map(|p| p.timing));
+    });
+    assert_eq!(h.closed.controller.status().state, ControllerState::Done);
+    assert!(timings.iter().all(|t| *t == PhaseTiming::Configured));
+}
+
+/// A learned walk paced for 0.18 m/s carries its stances' durations to the dynamic gait: its
+/// supports are planned from them (within the config's limits), and it reaches `done`.
+#[test]
+fn a_paced_learned_walk_is_planned_from_its_stance_durations() {
+    let robot_name = "jvrc1";
+    let mut h = Harness::dynamic(robot_name, 500.0);
+    let config = kinematics::ConfigFile::load(&config_path(robot_name)).expect("config loads");
+    let params = PostProcessParams::from_config_for(&config, Gait::Dynamic).expect("params");
+    let gaits = kinematic_gait_config(robot_name);
+    let dynamic = gaits.dynamic().expect("a dynamic gait");
+    let limits = [
+        dynamic.timed_single_support(),
+        dynamic.timed_double_support(),
+    ];
+    let model = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../data/models/default-ngram.json"
+    );
+    let source = StanceSource::learned(std::path::Path::new(model), None).expect("model loads");
+    let request = WalkRequest {
+        speed: Some(stance::WalkingSpeed {
+            m_s: 0.18,
+            support_limits_s: limits,
+        }),
+        ..WalkRequest::feet(1.5, 0)
+    };
+    let sequence = generated(&h.robot, &params, &source, &request).expect("a paced walk");
+    assert!(sequence.stances().iter().all(|s| s.duration_s.is_some()));
+    h.start_dynamic(&sequence, &gaits);
+    let mut phases: Vec<(Phase, f64, PhaseTiming)> = Vec::new();
+    run(&mut h, 30_000, |h| {
+        let status = h.closed.controller.status();
+        if let Some(planned) = status.balance.planned_phase {
+            let phase = (status.phase, planned.duration_s, planned.timing);
+            if phases.last() != Some(&phase) {
+                phases.push(phase);
+            }
+        }
+    });
+    assert_eq!(h.closed.controller.status().state, ControllerState::Done);
+    let timed = phases
+        .iter()
+        .filter(|p| p.2 == PhaseTiming::Sequence)
+        .count();
+    assert!(timed * 4 > phases.len() * 3, "{phases:?}");
+    for (phase, duration, timing) in &phases {
+        if *phase == Phase::SingleSupport && *timing != PhaseTiming::Configured {
+            assert!(
+                (limits[0][0]..=limits[0][1]).contains(duration),
+                "{phases:?}"
+            );
+        }
+    }
 }

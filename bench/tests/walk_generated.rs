@@ -18,6 +18,7 @@ fn generated_walk(robot_name: &str, affordances: AffordanceSet, distance: f64, s
         distance,
         affordances,
         seed: 0,
+        speed: None,
     };
     let sequence = generated(&robot, &params, &StanceSource::Synthetic, &request)
         .expect("generation and post-processing run");

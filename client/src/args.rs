@@ -9,6 +9,9 @@ use shm_types::RuntimeConfig;
 /// How far a walk goes after post-processing (m): `--distance`, `--distances`.
 pub const DISTANCE_M: Range = Range::new(0.01, 1000.0);
 
+/// A requested walking speed (m/s): from a crawl to a human's brisk walk.
+pub const SPEED_M_S: Range = Range::new(0.01, 3.0);
+
 /// A control rate (Hz): every `--rate-hz`, the range of `[runtime] rate_hz`.
 pub const RATE_HZ: Range = Range::new(
     *RuntimeConfig::RATE_HZ.start(),

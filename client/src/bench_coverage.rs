@@ -67,6 +67,7 @@ pub fn run(args: &BenchCoverageArgs) -> anyhow::Result<()> {
                     affordances,
                     railing: None,
                     search,
+                    speed: None,
                 };
                 let raw = generate_learned(&robot, &model, &options)
                     .with_context(|| format!("{requested} m, {affordances}, {search:?}"))?

@@ -14,13 +14,15 @@ use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::process::Physics;
 use shm_types::{ClockMode, DaemonState, DaemonStatus, LatencySummary, RuntimeConfig};
+use stance::learned::SourceArgs;
 use stance::{Gait, Scene, WalkRequest};
 
-use crate::args::{DISTANCE_M, RATE_HZ};
+use crate::args::{DISTANCE_M, RATE_HZ, SPEED_M_S};
 use crate::daemon_client::connect_when_fresh;
 use crate::daemon_client::{DaemonClient, feet_midpoint, status_text};
 use crate::evaluate::truth::judged_outcome;
 use crate::evaluate::watch::{WatchOptions, WatchedWalk, watch_walk};
+use crate::pace::walking_speed;
 use crate::process::{Launch, PlantArgs, Processes, executable_dir};
 use crate::watch::StanceProgress;
 
@@ -75,6 +77,12 @@ pub struct DemoArgs {
     /// Seed of the stance generator.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// Walking speed to pace the walk for (m/s, 0.01-3): step length and stance durations from
+    /// the model's gait law (docs/learning.md). Needs --model.
+    #[arg(long, value_name = "V", value_parser = SPEED_M_S.parser(), requires = "model")]
+    pub speed: Option<f64>,
     /// Gait: static or dynamic (default: the config's `[gait] default`). The walk is
     /// post-processed with that gait's limits and asks walkd for it. A gait the robot cannot
     /// walk is refused before anything is started.
@@ -228,26 +236,6 @@ pub fn walk_sequence(
     )?)
 }
 
-/// [`walk_sequence`] through `scene`, from its start to its goal: the synthetic walk of the
-/// path's length, post-processed onto the scene's surfaces.
-pub fn scene_walk_sequence(
-    robot: &Robot,
-    file: &ConfigFile,
-    scene: &Scene,
-    seed: u64,
-    gait: Gait,
-) -> anyhow::Result<stance::PostProcessedSequence> {
-    let params = stance::PostProcessParams::from_config_for(file, gait)?;
-    let request = WalkRequest::feet(scene.path_length(), seed);
-    Ok(stance::walk_in(
-        robot,
-        &params,
-        &request,
-        &scene.walk_environment(),
-        |options| stance::generate(robot, options),
-    )?)
-}
-
 /// The scene of `--scene`, refused before anything starts when the simulator cannot model it.
 pub fn load_scene(path: Option<&Path>, physics: Physics) -> anyhow::Result<Option<Scene>> {
     let Some(path) = path else {
@@ -275,9 +263,23 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         .unwrap_or(runtime.service_prefix);
     let robot = std::sync::Arc::new(Robot::from_config(&file, args.urdf.as_deref())?);
     let scene = load_scene(args.scene.as_deref(), args.physics)?;
+    let source = args.source.load()?;
+    let params = stance::PostProcessParams::from_config_for(&file, gait)?;
+    let request = WalkRequest {
+        speed: walking_speed(args.speed, &file, gait)?,
+        ..WalkRequest::feet(args.distance, args.seed)
+    };
     let sequence = match &scene {
-        Some(scene) => scene_walk_sequence(&robot, &file, scene, args.seed, gait)?,
-        None => walk_sequence(&robot, &file, args.distance, args.seed, gait)?,
+        Some(scene) => source.walk_in(
+            &robot,
+            &params,
+            &WalkRequest {
+                distance: scene.path_length(),
+                ..request
+            },
+            &scene.walk_environment(),
+        )?,
+        None => source.walk(&robot, &params, &request)?,
     };
     let mut children = Processes::default();
     let running = DaemonClient::connect(&prefix).is_ok_and(|client| client.is_running());

@@ -30,6 +30,7 @@ pub mod footholds;
 pub(crate) mod hands;
 pub mod record;
 pub mod stop;
+pub mod timing;
 pub(crate) mod truth;
 pub(crate) mod watch;
 
@@ -51,12 +52,16 @@ use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Point3, Vector3};
 use shm_types::process::Physics;
 use shm_types::{ClockMode, DaemonState, SimTruth};
+use stance::learned::{SourceArgs, StanceSource};
 use stance::poses::FEET;
 use stance::{AffordanceSet, Gait, PostProcessedSequence, Scene, WalkRequest};
 
+use crate::args::SPEED_M_S;
 use crate::daemon_client::connect_when_fresh;
+use crate::pace::walking_speed;
 use crate::process::{Launch, PlantArgs, executable_dir};
 use stop::{InjectArgs, Injection, StopReport};
+use timing::TimingReport;
 use watch::{WatchOptions, watch_walk};
 
 /// Arguments of `walkctl evaluate`.
@@ -105,6 +110,13 @@ pub struct EvaluateArgs {
     /// of on the flat floor; the path's length replaces `--distances`. Needs `--physics mujoco`.
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
+    /// The stance source of every walk (default: the synthetic generator).
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// Walking speed to pace every walk for (m/s, 0.01-3): step length and stance durations
+    /// from the model's gait law (docs/learning.md). Needs --model.
+    #[arg(long, value_name = "V", value_parser = SPEED_M_S.parser(), requires = "model")]
+    pub speed: Option<f64>,
 }
 
 /// The CoM and both soles' positions in the world (m).
@@ -252,6 +264,10 @@ pub struct RunResult {
     /// The held hands' mean vertical force over the robot's weight while a hand is planned in
     /// contact, from the simulator's contact forces; `None` without a held hand.
     pub hand_support_share: Option<f64>,
+    /// The walking speed asked of the walk (m/s), if any.
+    pub requested_speed_m_s: Option<f64>,
+    /// The dynamic gait's planned phases, from walkd's telemetry; `None` for the static gait.
+    pub timing: Option<TimingReport>,
 }
 
 impl RunResult {
@@ -285,6 +301,8 @@ impl RunResult {
             "terrain_collisions": self.steps.terrain_collisions,
             "foothold_error_m": self.steps.foothold_error_m,
             "hand_support_share": self.hand_support_share,
+            "requested_speed_m_s": self.requested_speed_m_s,
+            "timing": self.timing,
             "injected": self.stop.map(|stop| serde_json::json!({
                 "fault": stop.injection.fault.name(),
                 "at": stop.injection.moment.name(),
@@ -349,6 +367,7 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         .requests()?,
         None => args.cells.requests()?,
     };
+    let source = args.source.load()?;
     let subjects = args
         .robots
         .iter()
@@ -366,16 +385,24 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         for (i, (request, injection)) in runs.enumerate() {
             let pictured = args.snapshots.as_deref().filter(|_| i == 0);
             let run = (i, request);
-            let result = run_once(args, subject, run, scene.as_ref(), *injection, pictured)
-                .with_context(|| {
-                    format!(
-                        "{robot} {} {} m run {}{}",
-                        request.affordances,
-                        request.distance,
-                        request.seed,
-                        injection.map_or_else(String::new, |i| format!(" ({})", i.label()))
-                    )
-                })?;
+            let result = run_once(
+                args,
+                &source,
+                subject,
+                run,
+                scene.as_ref(),
+                *injection,
+                pictured,
+            )
+            .with_context(|| {
+                format!(
+                    "{robot} {} {} m run {}{}",
+                    request.affordances,
+                    request.distance,
+                    request.seed,
+                    injection.map_or_else(String::new, |i| format!(" ({})", i.label()))
+                )
+            })?;
             if !args.json {
                 eprintln!("{}", row(&result));
             }
@@ -419,11 +446,13 @@ fn plot_robot(dir: &Path, robot: &str, results: &[RunResult]) -> anyhow::Result<
     write_fig6(&file, &title, &result.trace, &result.balance)
 }
 
-/// Run number `slot` of a robot: own processes on an own prefix, submit, record, stop; through
+/// Run number `slot` of a robot, its walk from `source`: own processes on an own prefix, submit,
+/// record, stop; through
 /// `scene` if any; with `injection`, walk-sim injects that fault; with `pictured`, the
 /// snapshots of `--snapshots` go there.
 fn run_once(
     args: &EvaluateArgs,
+    source: &StanceSource,
     subject: &Subject,
     (slot, request): (usize, &WalkRequest),
     scene: Option<&Scene>,
@@ -440,20 +469,19 @@ fn run_once(
     } = subject;
     let (robot, gait) = (*robot, *gait);
     let params = stance::PostProcessParams::from_config_for(file, gait)?;
+    let request = &WalkRequest {
+        speed: walking_speed(args.speed, file, gait)?,
+        ..*request
+    };
     let &WalkRequest {
         distance,
         affordances,
         seed: run,
+        ..
     } = request;
     let sequence = match scene {
-        Some(scene) => stance::walk_in(
-            model,
-            &params,
-            request,
-            &scene.walk_environment(),
-            |options| stance::generate(model, options),
-        )?,
-        None => stance::synthetic_walk(model, &params, request)?,
+        Some(scene) => source.walk_in(model, &params, request, &scene.walk_environment())?,
+        None => source.walk(model, &params, request)?,
     };
     // One prefix a run: the runs of one walk with different faults follow each other, and a new
     // walkd must not meet the services of the last one while they are being torn down.
@@ -600,13 +628,15 @@ fn run_once(
         stop,
         steps,
         hand_support_share,
+        requested_speed_m_s: request.speed.map(|speed| speed.m_s),
+        timing: TimingReport::of(&walk.phases),
     })
 }
 
 fn row(result: &RunResult) -> String {
     let r = &result.record;
     format!(
-        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{} {}{}{}",
+        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {}{} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{} {}{}{}{}",
         result.robot,
         result.gait.name(),
         r.affordances.name(),
@@ -620,6 +650,9 @@ fn row(result: &RunResult) -> String {
         r.walked_m,
         r.speed_m_s
             .map_or_else(|| "no step".to_owned(), |v| format!("{v:.3} m/s")),
+        result
+            .requested_speed_m_s
+            .map_or_else(String::new, |v| format!(" (asked {v:.3} m/s)")),
         result.final_position_error_m,
         r.drift_m
             .map_or_else(|| "n/a".to_owned(), |d| format!("{d:.4} m")),
@@ -632,7 +665,10 @@ fn row(result: &RunResult) -> String {
             .map_or_else(String::new, |share| format!(" hand share {share:.3}")),
         r.actuators
             .as_ref()
-            .map_or_else(String::new, |a| format!(" {}", a.describe()))
+            .map_or_else(String::new, |a| format!(" {}", a.describe())),
+        result
+            .timing
+            .map_or_else(String::new, |t| format!(" {}", t.describe()))
     )
 }
 

@@ -6,10 +6,11 @@ use std::path::PathBuf;
 use anyhow::{Context, anyhow};
 use kinematics::ConfigFile;
 use kinematics::bounds::Range;
-use stance::learned::SourceArgs;
+use stance::learned::{SourceArgs, SpeedRequest};
 use stance::{AffordanceSet, Gait, GenerateOptions, Scene};
 
-use crate::args::DISTANCE_M;
+use crate::args::{DISTANCE_M, SPEED_M_S};
+use crate::pace::walking_speed;
 use crate::postprocess::{ParamOverrides, load_robot};
 
 /// Arguments of `walkctl generate`.
@@ -44,6 +45,10 @@ pub struct GenerateArgs {
     /// Seed of the deterministic random source.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Walking speed to pace the walk for (m/s, 0.01-3, after post-processing): step length and
+    /// stance durations from the model's gait law (docs/learning.md). Needs --model.
+    #[arg(long, value_name = "V", value_parser = SPEED_M_S.parser(), requires = "model")]
+    pub speed: Option<f64>,
     /// Where to write the raw stance file.
     #[arg(short, long, value_name = "RAW.json")]
     pub output: PathBuf,
@@ -63,15 +68,15 @@ fn parse_interval(text: &str) -> Result<[f64; 2], String> {
 
 /// Runs `walkctl generate`.
 pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
-    // The gait only picks the limits (`scf`) here, but a walk the robot cannot make is refused
-    // now, before anything is written, rather than by walkd.
-    Gait::for_walk(args.params.gait, &ConfigFile::load(&args.robot)?)?;
+    // The gait only picks the limits here (`scf`, and with --speed the shortest supports), but
+    // a walk the robot cannot make is refused now, before anything is written, rather than by
+    // walkd.
+    let file = ConfigFile::load(&args.robot)?;
+    let gait = Gait::for_walk(args.params.gait, &file)?;
+    let speed = walking_speed(args.speed, &file, gait)?;
     let robot = load_robot(&args.robot, args.urdf.as_deref())?;
-    let scale = if args.raw_distance {
-        1.0
-    } else {
-        1.0 / args.params.load(&args.robot)?.scf
-    };
+    let scf = args.params.load(&args.robot)?.scf;
+    let scale = if args.raw_distance { 1.0 } else { 1.0 / scf };
     let scene = args.scene.as_deref().map(Scene::from_path).transpose()?;
     let walk_distance = match &scene {
         Some(scene) => scene.path_length(),
@@ -89,10 +94,15 @@ pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
         affordances: args.affordances,
         seed: args.seed,
     };
-    let sourced = args
-        .source
-        .load()?
-        .generate(&robot, &options, Some(railing))?;
+    let sourced = args.source.load()?.generate(
+        &robot,
+        &options,
+        Some(railing),
+        speed.map(|speed| SpeedRequest { speed, scf }),
+    )?;
+    if let Some(gait) = &sourced.gait {
+        eprintln!("{}", gait.describe());
+    }
     if let Some([position, orientation]) = sourced.largest_ik_error {
         eprintln!(
             "retargeted {} stances: largest IK error {position:.1e} m, {orientation:.1e} rad",

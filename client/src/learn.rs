@@ -1,13 +1,17 @@
 //! `walkctl learn`: train the n-gram stance model on demonstration folders (each with a
-//! `demo.toml` manifest) and write it as JSON; optionally report realism against a held-out
-//! folder.
+//! `demo.toml` manifest) and write it as JSON, report the gait law fitted on the walkers, and
+//! optionally realism against a held-out folder.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::builder::RangedU64ValueParser;
 use kinematics::bounds::Range;
-use stance::learned::{NgramModel, TrainOptions, load_folder, segment, taxonomy_label};
+use stance::learned::gait_law::walker_table;
+use stance::learned::{
+    Demonstration, GaitLaw, NgramModel, TrainOptions, WalkerGait, load_folder, segment,
+    taxonomy_label,
+};
 
 /// Arguments of `walkctl learn`.
 #[derive(Debug, Clone, clap::Args)]
@@ -15,6 +19,10 @@ pub struct LearnArgs {
     /// Demonstration folders, each with a demo.toml (e.g. data/demonstrations/gaitalytics).
     #[arg(long, value_name = "DIR", num_args = 1.., required = true)]
     pub demos: Vec<PathBuf>,
+    /// Demonstration folders whose level walkers enter only the gait law (step length and
+    /// timing over speed), not the n-gram (e.g. data/demonstrations/gaitkit-walkers).
+    #[arg(long, value_name = "DIR", num_args = 1..)]
+    pub gait_demos: Vec<PathBuf>,
     /// Where to write the model.
     #[arg(short, long, value_name = "MODEL.json")]
     pub output: PathBuf,
@@ -38,10 +46,7 @@ pub struct LearnArgs {
 
 /// Runs `walkctl learn`.
 pub fn run(args: &LearnArgs) -> anyhow::Result<()> {
-    let mut demos = Vec::new();
-    for dir in &args.demos {
-        demos.extend(load_folder(dir)?);
-    }
+    let (demos, gait_demos) = (load_folders(&args.demos)?, load_folders(&args.gait_demos)?);
     let options = TrainOptions {
         order: args.order,
         discount: args.discount,
@@ -69,7 +74,7 @@ pub fn run(args: &LearnArgs) -> anyhow::Result<()> {
             classes.join(", ")
         );
     }
-    let model = NgramModel::train(&demos, &options)?;
+    let model = NgramModel::train_with_gait_walkers(&demos, &gait_demos, &options)?;
     std::fs::write(&args.output, model.to_json_string() + "\n")
         .with_context(|| format!("writing {}", args.output.display()))?;
     eprintln!(
@@ -80,8 +85,39 @@ pub fn run(args: &LearnArgs) -> anyhow::Result<()> {
         model.counts.len(),
         model.human_pelvis_height
     );
+    print_gait_law(&model, demos.iter().chain(&gait_demos));
     if let Some(dir) = &args.holdout {
         crate::realism::print_comparison(&model, dir)?;
     }
     Ok(())
+}
+
+/// The trials of all the folders `dirs`, in order.
+fn load_folders(dirs: &[PathBuf]) -> anyhow::Result<Vec<Demonstration>> {
+    let mut demos = Vec::new();
+    for dir in dirs {
+        demos.extend(load_folder(dir)?);
+    }
+    Ok(demos)
+}
+
+/// Prints the walkers the gait law is fitted on (with the reason for each trial left out) and
+/// the law stored in the model, or why the model has none.
+fn print_gait_law<'a>(model: &NgramModel, demos: impl Iterator<Item = &'a Demonstration>) {
+    println!("gait law walkers (level ground, ≥ 3 complete steps; medians over the steps):");
+    let mut walkers = Vec::new();
+    for demo in demos {
+        match WalkerGait::measure(demo) {
+            Ok(walker) => walkers.push(walker),
+            Err(reason) => println!("{}: left out: {reason}", demo.name),
+        }
+    }
+    print!("{}", walker_table(&walkers));
+    match &model.gait_law {
+        Some(law) => println!("{law}"),
+        None => println!(
+            "no gait law stored in the model: {}",
+            GaitLaw::fit(&walkers).err().unwrap_or_default()
+        ),
+    }
 }

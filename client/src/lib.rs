@@ -17,6 +17,7 @@ pub mod init_robot;
 pub mod inspect;
 pub mod learn;
 pub mod observe;
+pub mod pace;
 pub mod postprocess;
 pub mod process;
 pub mod realism;

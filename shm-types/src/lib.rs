@@ -50,15 +50,16 @@ pub use messages::{
 pub use wire::{Code, DecodeError, Flag};
 
 pub use services::ServiceNames;
-pub use telemetry::{SUPPORT_VERTICES, Telemetry, WalkPhase};
+pub use telemetry::{SUPPORT_VERTICES, Telemetry, TimingSource, WalkPhase};
 pub use text::FixedText;
 
 /// Version of the wire protocol; part of every message's `#[type_name]`. Version 2: enums and
 /// flags travel as checked integers ([`wire`]); version 3: the daemon state `controlled_stop`;
 /// version 4: the simulator's actuator load in [`SimTruth`]; version 5: the count of the legs'
 /// terrain collisions in [`SimTruth`]; version 6: the environment's force on each palm in
-/// [`SimTruth`].
-pub const PROTOCOL_VERSION: u32 = 6;
+/// [`SimTruth`]; version 7: the planned duration of the dynamic gait's current phase and its
+/// source in [`Telemetry`].
+pub const PROTOCOL_VERSION: u32 = 7;
 
 /// Fixed joint capacity of the joint arrays; messages carry the used count explicitly.
 pub const MAX_JOINTS: usize = 64;

@@ -52,10 +52,25 @@ wire_enum! {
     }
 }
 
+wire_enum! {
+    /// Where the planned duration of the dynamic gait's current phase came from
+    /// ([`Telemetry::phase_duration_s`]).
+    pub enum TimingSource {
+        /// No planned phase: the static gait, not executing, or settling after the last phase.
+        None = 0 => "none",
+        /// The robot config's duration (an untimed sequence, or a phase a sequence does not time).
+        Config = 1 => "config",
+        /// The sequence's stance durations, as it gave them.
+        Sequence = 2 => "sequence",
+        /// The sequence's stance durations, moved into the config's limits.
+        Clamped = 3 => "clamped",
+    }
+}
+
 /// What the controller estimated and aimed at in one control tick (walkd → observers).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v6.Telemetry")]
+#[type_name("walk.v7.Telemetry")]
 pub struct Telemetry {
     /// Increases by one with every telemetry published in a daemon run, from 1: a gap means a
     /// subscriber lost messages.
@@ -97,6 +112,9 @@ pub struct Telemetry {
     pub dcm_reference: [f64; 2],
     /// Measured DCM (x, y) (valid where `dynamics_valid`).
     pub dcm_measured: [f64; 2],
+    /// Planned duration of the dynamic gait's current phase (s; 0 where `phase_timing` is
+    /// `none`): a client sees the step times a timed sequence set.
+    pub phase_duration_s: f64,
     /// Valid vertices in `support`.
     pub support_count: u32,
     /// Index of the stance being moved towards.
@@ -107,6 +125,8 @@ pub struct Telemetry {
     pub state: Code<DaemonState>,
     /// The transition phase after this tick.
     pub phase: Code<WalkPhase>,
+    /// Where `phase_duration_s` came from.
+    pub phase_timing: Code<TimingSource>,
     /// End-effectors in the controller's contact set.
     pub contacts: [Flag; 4],
     /// Which entries of `targets` hold a target.
@@ -138,11 +158,13 @@ impl Telemetry {
         zmp_measured: [0.0; 2],
         dcm_reference: [0.0; 2],
         dcm_measured: [0.0; 2],
+        phase_duration_s: 0.0,
         support_count: 0,
         stance_index: 0,
         stance_count: 0,
         state: Code::from_raw(0),
         phase: Code::from_raw(0),
+        phase_timing: Code::from_raw(0),
         contacts: [Flag::NO; 4],
         target_set: [Flag::NO; 4],
         com_target_set: Flag::NO,
@@ -174,6 +196,19 @@ mod tests {
         assert_eq!(telemetry.support()[2], [0.5, -0.25]);
         telemetry.support_count = 1000;
         assert_eq!(telemetry.support().len(), SUPPORT_VERTICES);
+    }
+
+    /// The fields protocol v7 added sit next to fields of their size, without padding before or
+    /// after them, so the layout is the same on every target iceoryx2 maps it on.
+    #[test]
+    fn the_phase_timing_fields_add_no_padding() {
+        use std::mem::{offset_of, size_of};
+        let after_dcm = offset_of!(Telemetry, dcm_measured) + size_of::<[f64; 2]>();
+        assert_eq!(offset_of!(Telemetry, phase_duration_s), after_dcm);
+        assert_eq!(offset_of!(Telemetry, support_count), after_dcm + 8);
+        let after_phase = offset_of!(Telemetry, phase) + size_of::<u32>();
+        assert_eq!(offset_of!(Telemetry, phase_timing), after_phase);
+        assert_eq!(offset_of!(Telemetry, contacts), after_phase + 4);
     }
 
     #[test]

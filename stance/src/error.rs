@@ -74,12 +74,12 @@ pub enum FormatError {
     /// The document is JSON, but not an object (serde would read an array as the fields in
     /// order and complain about the first one's type).
     #[error(
-        "a stance file is a JSON object ({{\"format_version\": 1, \"kind\": ..., \"stances\": [...]}}), not {found}"
+        "a stance file is a JSON object ({{\"format_version\": 2, \"kind\": ..., \"stances\": [...]}}), not {found}"
     )]
     NotAnObject { found: &'static str },
     /// A `format_version` this code does not read.
     #[error(
-        "field `format_version`: version {found} is not supported (this build reads {supported})"
+        "field `format_version`: version {found} is not supported (this build reads 1 to {supported})"
     )]
     UnsupportedVersion { found: u64, supported: u32 },
     /// A post-processed file where a raw one is expected or vice versa.

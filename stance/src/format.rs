@@ -1,7 +1,7 @@
 //! The versioned JSON stance file (DESIGN.md §3) and its strict reader.
 //!
 //! ```json
-//! { "format_version": 1, "kind": "raw" | "post_processed", "robot": "armar4",
+//! { "format_version": 2, "kind": "raw" | "post_processed", "robot": "armar4",
 //!   "joint_names": ["..."],
 //!   "environment": { "surfaces": [{ "name": "ground",
 //!                                   "pose": { "translation": [0, 0, 0], "rotation": [0, 0, 0, 1] },
@@ -9,9 +9,11 @@
 //!                    "hand_affordances": [{ "name": "railing", "start": [..], "end": [..],
 //!                                           "radius": 0.02, "available": [0.0, 5.0] }] },
 //!   "stances": [{ "q": [..], "contacts": ["left_foot", "right_foot"],
-//!                 "translation": [x, y, z], "root_orientation": [x, y, z, w],
+//!                 "translation": [x, y, z], "root_orientation": [x, y, z, w], "duration_s": 0.4,
 //!                 "targets": { "left_foot": { "translation": [..], "rotation": [..] }, .. } }] }
 //! ```
+//! Version 2 (written; 1 is still read) adds each stance's optional `"duration_s"`: how long the
+//! walk stays in it (s, in (0, 60]); absent, the gait's configured timing applies.
 //! `targets` is present exactly in post-processed files; so is the optional `"gait": "static" |
 //! "dynamic"`, the gait whose limits post-processed the sequence and that walks it (absent: the
 //! robot config's default). `root_orientation` defaults to the identity. A hand affordance's
@@ -30,8 +32,17 @@ use crate::json_path::{location_at, offset_of};
 use crate::params::Gait;
 use crate::sequence::{PostProcessedSequence, RawSequence, Stance, StanceSequence};
 
-/// The file format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 1;
+/// The file format version this build writes; it reads this one and every earlier one.
+/// Version 2 added the stances' optional `duration_s`.
+pub const FORMAT_VERSION: u32 = 2;
+
+/// The oldest version this build still reads.
+const OLDEST_VERSION: u64 = 1;
+
+/// Whether this build reads files of `version`.
+fn readable(version: u64) -> bool {
+    (OLDEST_VERSION..=u64::from(FORMAT_VERSION)).contains(&version)
+}
 
 #[derive(Serialize, Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
 #[serde(rename_all = "snake_case")]
@@ -77,6 +88,8 @@ struct StanceDto {
     root_orientation: Option<[f64; 4]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     targets: Option<TargetsDto>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    duration_s: Option<f64>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -378,19 +391,28 @@ fn parse_file(text: &str, expected: Kind) -> Result<FileDto, FormatError> {
     top_level_object(text)?;
     let file: FileDto = serde_json::from_str(text).map_err(|error| {
         match serde_json::from_str::<VersionProbe>(text) {
-            Ok(probe) if probe.format_version != u64::from(FORMAT_VERSION) => {
-                FormatError::UnsupportedVersion {
-                    found: probe.format_version,
-                    supported: FORMAT_VERSION,
-                }
-            }
+            Ok(probe) if !readable(probe.format_version) => FormatError::UnsupportedVersion {
+                found: probe.format_version,
+                supported: FORMAT_VERSION,
+            },
             _ => json_error(text, error),
         }
     })?;
-    if file.format_version != u64::from(FORMAT_VERSION) {
+    if !readable(file.format_version) {
         return Err(FormatError::UnsupportedVersion {
             found: file.format_version,
             supported: FORMAT_VERSION,
+        });
+    }
+    if file.format_version < 2
+        && let Some(i) = file.stances.iter().position(|s| s.duration_s.is_some())
+    {
+        return Err(FormatError::Invalid {
+            location: Location::stance(i, "duration_s"),
+            message: format!(
+                "a stance duration needs format_version 2 (the file says {})",
+                file.format_version
+            ),
         });
     }
     if file.kind != expected {
@@ -418,6 +440,7 @@ fn into_parts(file: FileDto) -> Result<FileParts, FormatError> {
             root_orientation: dto
                 .root_orientation
                 .map_or_else(UnitQuaternion::identity, quaternion),
+            duration_s: dto.duration_s,
         });
         targets.push(dto.targets);
     }
@@ -443,6 +466,7 @@ fn stance_dto(stance: &Stance, targets: Option<&[Isometry3<f64>; 4]>) -> StanceD
             left_hand: (&t[EndEffector::LeftHand as usize]).into(),
             right_hand: (&t[EndEffector::RightHand as usize]).into(),
         }),
+        duration_s: stance.duration_s,
     }
 }
 

@@ -11,6 +11,7 @@
 //! - [`Scene`] ([`scene`]): a versioned TOML scene file (surfaces, railings, start and goal),
 //!   validated strictly into an [`Environment`] and the walk's start and goal.
 //! - [`walk`]: a walk of a given distance (generated for `distance / scf`, then post-processed).
+//! - [`timing`]: timed stances' durations kept consistent with the steps the passes change.
 //! - [`derived`]: step sizes, swing heights, orthogonal foot distances.
 //! - `plot` (feature `plot`): SVG figures of sequences.
 //!
@@ -35,6 +36,7 @@ pub mod poses;
 pub mod scene;
 pub mod sequence;
 mod stance_ik;
+pub mod timing;
 pub mod walk;
 
 pub use environment::{Environment, HandAffordance, SupportSurface};
@@ -48,4 +50,4 @@ pub use pipeline::PostProcessor;
 pub use poses::PoseSequence;
 pub use scene::{Scene, SceneError};
 pub use sequence::{NoRailing, PostProcessedSequence, RawSequence, Stance, StanceSequence};
-pub use walk::{WalkRequest, synthetic_walk, walk_in};
+pub use walk::{WalkRequest, WalkingSpeed, synthetic_walk, walk_in};

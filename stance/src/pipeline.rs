@@ -11,6 +11,7 @@ use crate::params::PostProcessParams;
 use crate::passes::{ContactGeometry, Pass, run_passes, run_passes_observed};
 use crate::poses::PoseSequence;
 use crate::sequence::{PostProcessedSequence, RawSequence, Stance};
+use crate::timing::{FeetPositions, feet_positions, retime_swings};
 
 /// Reusable post-processing workspace for one robot: once its buffers (and the output's) have
 /// grown to the longest sequence seen, [`PostProcessor::process_into`] does not allocate.
@@ -22,6 +23,10 @@ pub struct PostProcessor<'r> {
     effector_links: FrameSet,
     configuration: Configuration,
     poses: PoseSequence,
+    /// The feet in every raw stance, before the passes: what the stances were timed for.
+    planned_feet: FeetPositions,
+    /// The stances' durations after the passes ([`crate::timing`]).
+    durations: Vec<Option<f64>>,
 }
 
 impl<'r> PostProcessor<'r> {
@@ -34,6 +39,8 @@ impl<'r> PostProcessor<'r> {
             effector_links: FrameSet::new(&robot.model, &EndEffector::ALL.map(|e| robot.frame(e))),
             configuration: robot.standing.clone(),
             poses: PoseSequence::default(),
+            planned_feet: FeetPositions::new(),
+            durations: Vec::new(),
         }
     }
 
@@ -82,15 +89,30 @@ impl<'r> PostProcessor<'r> {
         out: &mut PostProcessedSequence,
     ) -> Result<(), FormatError> {
         self.forward_kinematics(raw)?;
+        feet_positions(&self.poses, &mut self.planned_feet);
         run_passes(
             &mut self.poses,
             raw.environment(),
             &self.params,
             &ContactGeometry::of(self.robot),
         );
-        out.assign(raw, &self.poses);
+        self.retime(raw);
+        out.assign(raw, &self.poses, &self.durations);
         out.gait = Some(self.params.gait);
         Ok(())
+    }
+
+    /// The raw stances' durations, kept consistent with the steps the passes changed.
+    fn retime(&mut self, raw: &RawSequence) {
+        self.durations.clear();
+        self.durations
+            .extend(raw.stances().iter().map(|stance| stance.duration_s));
+        retime_swings(
+            &self.planned_feet,
+            &self.poses,
+            self.params.scf,
+            &mut self.durations,
+        );
     }
 
     /// [`PostProcessor::process`] that also hands the poses after each pass to `after` (Fig. 3).
@@ -100,6 +122,7 @@ impl<'r> PostProcessor<'r> {
         after: impl FnMut(Pass, &PoseSequence),
     ) -> Result<PostProcessedSequence, FormatError> {
         self.forward_kinematics(raw)?;
+        feet_positions(&self.poses, &mut self.planned_feet);
         run_passes_observed(
             &mut self.poses,
             raw.environment(),
@@ -107,8 +130,9 @@ impl<'r> PostProcessor<'r> {
             &ContactGeometry::of(self.robot),
             after,
         );
+        self.retime(raw);
         let mut out = PostProcessedSequence::empty();
-        out.assign(raw, &self.poses);
+        out.assign(raw, &self.poses, &self.durations);
         out.gait = Some(self.params.gait);
         Ok(out)
     }
@@ -116,8 +140,9 @@ impl<'r> PostProcessor<'r> {
 
 impl PostProcessedSequence {
     /// Overwrites `self` with `raw`'s stances (same `q_S` and contacts, root translations from the
-    /// post-processed roots) and the post-processed end-effector poses, reusing buffers.
-    fn assign(&mut self, raw: &RawSequence, poses: &PoseSequence) {
+    /// post-processed roots, `durations`) and the post-processed end-effector poses, reusing
+    /// buffers.
+    fn assign(&mut self, raw: &RawSequence, poses: &PoseSequence, durations: &[Option<f64>]) {
         let sequence = &mut self.sequence;
         if sequence.robot != raw.robot {
             sequence.robot.clone_from(&raw.robot);
@@ -130,7 +155,8 @@ impl PostProcessedSequence {
         }
         sequence.stances.truncate(poses.len());
         let mut previous = Vector3::zeros();
-        for (i, (stance, root)) in raw.stances.iter().zip(&poses.roots).enumerate() {
+        let stances = raw.stances.iter().zip(&poses.roots).zip(durations);
+        for (i, ((stance, root), &duration_s)) in stances.enumerate() {
             let translation = root.translation.vector - previous;
             previous = root.translation.vector;
             match sequence.stances.get_mut(i) {
@@ -140,9 +166,11 @@ impl PostProcessedSequence {
                     existing.contacts = stance.contacts;
                     existing.translation = translation;
                     existing.root_orientation = stance.root_orientation;
+                    existing.duration_s = duration_s;
                 }
                 None => sequence.stances.push(Stance {
                     translation,
+                    duration_s,
                     ..stance.clone()
                 }),
             }

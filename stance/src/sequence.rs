@@ -23,6 +23,10 @@ pub struct Stance {
     /// Orientation of the root in the world. Eq. 1 has none (the identity is its default in the
     /// file); a retargeted stance needs it to reproduce the end-effector poses it was solved for.
     pub root_orientation: UnitQuaternion<f64>,
+    /// How long the walk stays in this stance, from reaching it until it moves on (s): a timed
+    /// stance, its duration from the demonstrations. `None`: untimed, the gait's configured
+    /// timing applies (every file of format version 1).
+    pub duration_s: Option<f64>,
 }
 
 impl Stance {
@@ -390,6 +394,29 @@ fn validate(
         if !stance.in_contact(EndEffector::LeftFoot) && !stance.in_contact(EndEffector::RightFoot) {
             return Err(FormatError::NoFootSupport { stance: i });
         }
+        check_duration(stance.duration_s, i)?;
+    }
+    Ok(())
+}
+
+/// The longest stance duration accepted (s): a stance of a walk, not a pause.
+pub const MAX_STANCE_DURATION_S: f64 = 60.0;
+
+/// A stance duration, if any, is a finite number in (0, [`MAX_STANCE_DURATION_S`]].
+fn check_duration(duration_s: Option<f64>, stance: usize) -> Result<(), FormatError> {
+    let Some(duration) = duration_s else {
+        return Ok(());
+    };
+    if !duration.is_finite() {
+        return Err(FormatError::NonFinite {
+            location: Location::stance(stance, "duration_s"),
+        });
+    }
+    if !(duration > 0.0 && duration <= MAX_STANCE_DURATION_S) {
+        return Err(FormatError::Invalid {
+            location: Location::stance(stance, "duration_s"),
+            message: format!("{duration} s: must be in (0, {MAX_STANCE_DURATION_S}] s"),
+        });
     }
     Ok(())
 }

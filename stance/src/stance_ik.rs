@@ -93,6 +93,7 @@ impl<'a> StanceIk<'a> {
             contacts,
             translation: root - self.previous_root,
             root_orientation: self.current.base.rotation,
+            duration_s: None,
         };
         self.previous_root = root;
         Ok(SolvedStance { stance, errors })

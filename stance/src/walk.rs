@@ -21,6 +21,21 @@ pub struct WalkRequest {
     pub affordances: AffordanceSet,
     /// Seed of the stance source.
     pub seed: u64,
+    /// The walking speed asked for; `None`: the source's own pace. Only a learned source with a
+    /// gait law paces a walk (`stance::learned::pace`).
+    pub speed: Option<WalkingSpeed>,
+}
+
+/// A walking speed to pace a walk for, within the robot's timing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WalkingSpeed {
+    /// The walk's speed after post-processing (m/s).
+    pub m_s: f64,
+    /// The limits `[min, max]` (s) within which the robot's dynamic gait times a single and a
+    /// double support from a sequence: `[gait.dynamic] timed_single_support_s` and
+    /// `timed_double_support_s`. A paced walk plans every support within them, so that the
+    /// daemon walks it at the pace planned.
+    pub support_limits_s: [[f64; 2]; 2],
 }
 
 impl WalkRequest {
@@ -30,6 +45,7 @@ impl WalkRequest {
             distance,
             affordances: AffordanceSet::Feet,
             seed,
+            speed: None,
         }
     }
 
@@ -129,5 +145,8 @@ pub fn synthetic_walk(
     params: &PostProcessParams,
     request: &WalkRequest,
 ) -> Result<PostProcessedSequence, WalkError<GenerateError>> {
+    if request.speed.is_some() {
+        return Err(WalkError::Source(GenerateError::SpeedNeedsModel));
+    }
     walk_with(robot, params, request, |options| generate(robot, options))
 }

@@ -179,9 +179,9 @@ fn structural_errors_name_their_field() {
         "{err}"
     );
     assert!(err.to_string().contains("translaton"), "{err}");
-    let err = read_edited(|v| v["format_version"] = json!(2)).unwrap_err();
+    let err = read_edited(|v| v["format_version"] = json!(3)).unwrap_err();
     assert!(
-        matches!(err, FormatError::UnsupportedVersion { found: 2, .. }),
+        matches!(err, FormatError::UnsupportedVersion { found: 3, .. }),
         "{err}"
     );
     let err = read_edited(|v| v["stances"][0]["contacts"] = json!(["left_foot", "left_foot"]))
@@ -338,6 +338,45 @@ fn a_railing_radius_is_optional_and_zero_when_absent() {
     assert!(
         err.to_string()
             .contains("environment.hand_affordances[0].radius"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_stance_duration_is_optional_written_in_version_2_and_checked() {
+    let text = raw().to_json_string();
+    let value: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(value["format_version"], json!(2));
+    // Untimed stances write no duration, so a file of the previous version reads the same.
+    assert_eq!(value.pointer("/stances/0/duration_s"), None);
+    let old = read_edited(|v| v["format_version"] = json!(1)).unwrap();
+    assert_eq!(old, raw());
+    // A timed stance keeps its duration through the file.
+    let timed = read_edited(|v| v["stances"][1]["duration_s"] = json!(0.45)).unwrap();
+    assert_eq!(timed.stances()[1].duration_s, Some(0.45));
+    assert_eq!(timed.stances()[0].duration_s, None);
+    let again = RawSequence::from_json_str(&timed.to_json_string(), &common::jvrc1().0).unwrap();
+    assert_eq!(again, timed);
+    // Refused, naming the stance and the field: a zero, a negative, a too long and a
+    // non-finite duration, and a duration in a version-1 file.
+    for bad in [json!(0.0), json!(-0.2), json!(61.0)] {
+        let err = read_edited(|v| v["stances"][3]["duration_s"] = bad.clone()).unwrap_err();
+        assert!(
+            err.to_string().starts_with("stance 3, field `duration_s`"),
+            "{bad}: {err}"
+        );
+    }
+    let nan = with_number_spelled(&timed.to_json_string(), "/stances/1/duration_s", "NaN");
+    let err = RawSequence::from_json_str(&nan, &common::jvrc1().0).unwrap_err();
+    assert!(matches!(err, FormatError::NonFinite { .. }), "{err}");
+    let err = read_edited(|v| {
+        v["format_version"] = json!(1);
+        v["stances"][2]["duration_s"] = json!(0.5);
+    })
+    .unwrap_err();
+    assert!(
+        err.to_string().contains("stance 2, field `duration_s`")
+            && err.to_string().contains("format_version 2"),
         "{err}"
     );
 }

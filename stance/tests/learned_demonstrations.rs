@@ -118,17 +118,18 @@ fn synthetic(steps: usize, advance: f64) -> Value {
 
 #[test]
 fn corpus_trials_pass_the_checks() {
-    for (folder, trial) in [
-        ("gaitalytics", "treadmill_events"),
-        ("gaitkit", "example_healthy"),
+    for (folder, trials) in [
+        ("gaitalytics", &["treadmill_events"][..]),
+        ("gaitkit", &["example_healthy"]),
         (
             "holosoma-climb",
-            "mocap_climb_seq_1_joint_positions_f0-2422",
+            &["mocap_climb_seq_1_joint_positions_f0-2422"],
         ),
+        ("gaitkit-walkers", &["example_parkinson", "example_stroke"]),
     ] {
         let demos = load_folder(&corpus(folder)).unwrap_or_else(|e| panic!("{e}"));
         let names: Vec<&str> = demos.iter().map(|d| d.name.as_str()).collect();
-        assert_eq!(names, [trial]);
+        assert_eq!(names, trials);
     }
 }
 

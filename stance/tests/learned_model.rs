@@ -8,9 +8,10 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use stance::learned::coverage::covered_distance;
+use stance::learned::gait_law::walker_table;
 use stance::learned::realism::{compare, of_demonstrations};
 use stance::learned::{
-    Demonstration, LearnError, LearnedOptions, NgramModel, Query, Search, TrainOptions,
+    Demonstration, LearnError, LearnedOptions, NgramModel, Query, Search, TrainOptions, WalkerGait,
     generate_learned, generate_tokens, load_folder,
 };
 use stance::{AffordanceSet, PostProcessor};
@@ -19,17 +20,24 @@ fn repo(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path)
 }
 
-/// The default training set: the vendored corpus without the held-out gaitkit trial.
-fn training() -> Vec<Demonstration> {
-    ["gaitalytics", "holosoma-climb"]
+/// The trials of the corpus folders `folders`.
+fn corpus(folders: &[&str]) -> Vec<Demonstration> {
+    folders
         .iter()
         .flat_map(|f| load_folder(&repo("data/demonstrations").join(f)).unwrap())
         .collect()
 }
 
+/// The default model: the n-gram trained on the vendored corpus without the held-out gaitkit
+/// trial and the gait-law-only walkers, the gait law also fitted on those walkers.
 fn model() -> &'static NgramModel {
     static MODEL: OnceLock<NgramModel> = OnceLock::new();
-    MODEL.get_or_init(|| NgramModel::train(&training(), &TrainOptions::default()).unwrap())
+    MODEL.get_or_init(|| {
+        let training = corpus(&["gaitalytics", "holosoma-climb"]);
+        let gait_walkers = corpus(&["gaitkit-walkers"]);
+        NgramModel::train_with_gait_walkers(&training, &gait_walkers, &TrainOptions::default())
+            .unwrap()
+    })
 }
 
 fn walk(distance: f64, search: Search) -> Query {
@@ -230,6 +238,7 @@ fn retargeted_sequences_post_process_on_both_robots_for_all_affordance_sets() {
                     affordances,
                     railing: None,
                     search,
+                    speed: None,
                 };
                 let retargeted = generate_learned(robot, model, &options).unwrap();
                 let (raw, generated) = (&retargeted.raw, &retargeted.generated);
@@ -293,6 +302,7 @@ fn retargeted_sequences_keep_the_natural_impediments() {
         affordances: AffordanceSet::FeetLeftHand,
         railing: None,
         search: Search::Sample(0),
+        speed: None,
     };
     let raw = generate_learned(robot, model(), &options).unwrap().raw;
     let mut processor = PostProcessor::new(robot, params.clone());
@@ -330,7 +340,7 @@ fn retargeted_sequences_keep_the_natural_impediments() {
 fn bad_model_files_are_refused() {
     let text = model().to_json_string();
     let path = Path::new("model.json");
-    let broken = text.replacen("\"version\": 1", "\"version\": 9", 1);
+    let broken = text.replacen("\"version\": 2", "\"version\": 9", 1);
     let error = NgramModel::from_json_str(&broken, path)
         .unwrap_err()
         .to_string();
@@ -339,4 +349,140 @@ fn bad_model_files_are_refused() {
         .unwrap_err()
         .to_string();
     assert!(error.contains("model.json"), "{error}");
+}
+
+/// The default model's gait law goes through its training walkers (λ within 20 % at each one's
+/// own v̂), lengthens the steps and shortens the step time with speed, and leaves the climbing
+/// trial out (not level walking).
+#[test]
+fn gait_law_fits_the_training_walkers_and_steps_lengthen_with_speed() {
+    let law = model()
+        .gait_law
+        .as_ref()
+        .expect("the default model has a gait law");
+    println!("{}{law}", walker_table(law.walkers()));
+    assert!(law.walkers().len() >= 2, "{law}");
+    assert!(law.walkers().iter().all(|w| !w.name.contains("climb")));
+    for walker in law.walkers() {
+        let measured = walker.dimensionless();
+        let predicted = law.at(measured.froude_speed).step_length;
+        let error = predicted / measured.step_length - 1.0;
+        assert!(
+            error.abs() < 0.2,
+            "{}: λ {:.3}, the law gives {predicted:.3}",
+            walker.name,
+            measured.step_length
+        );
+    }
+    assert!(law.step_length.exponent > 0.0, "{law}");
+    let [slow, fast] = law.speed_range().map(|v| law.at(v));
+    assert!(fast.step_length > slow.step_length, "{slow:?} {fast:?}");
+    assert!(fast.step_time < slow.step_time, "{slow:?} {fast:?}");
+}
+
+/// The held-out healthy walker, never fitted on and a little faster than the fastest training
+/// walker: the law predicts its step length and step time within 15 % and its double-support
+/// share within 0.05.
+#[test]
+fn gait_law_predicts_the_held_out_walker() {
+    let law = model().gait_law.as_ref().unwrap();
+    let held_out = load_folder(&repo("data/demonstrations/gaitkit")).unwrap();
+    let measured = WalkerGait::measure(&held_out[0]).unwrap().dimensionless();
+    let predicted = law.at(measured.froude_speed);
+    println!("held-out {measured:?}\nlaw {predicted:?}");
+    let length = predicted.step_length / measured.step_length - 1.0;
+    let time = predicted.step_time / measured.step_time - 1.0;
+    assert!(
+        length.abs() < 0.15 && time.abs() < 0.15,
+        "λ {length:+.3}, τ {time:+.3}"
+    );
+    let share = predicted.double_support / predicted.step_time;
+    assert!(
+        (share - measured.double_support_share).abs() < 0.05,
+        "δ {share}"
+    );
+}
+
+/// Model files of version 1 (before the gait law) still load, without a law; a version 1 file
+/// with a law is refused.
+#[test]
+fn version_1_model_files_load_without_a_gait_law() {
+    let path = Path::new("v1.json");
+    let mut value: serde_json::Value = serde_json::from_str(&model().to_json_string()).unwrap();
+    value["version"] = 1.into();
+    let error = NgramModel::from_json_str(&value.to_string(), path)
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("version 1 has no gait law"), "{error}");
+    value.as_object_mut().unwrap().remove("gait_law");
+    let old = NgramModel::from_json_str(&value.to_string(), path).unwrap();
+    assert_eq!(old.gait_law, None);
+    assert_eq!(old.tokens, model().tokens);
+}
+
+/// A walk paced for a speed: every stance is timed, within the robot's timing limits, and the
+/// post-processed walk covers the distance at the speed (its length over the summed durations
+/// of the stances between the first and the last, which the gait times with its own standing
+/// phases); a slower request takes shorter steps and longer stances.
+#[test]
+fn a_paced_walk_is_timed_for_its_speed_within_the_robots_limits() {
+    use kinematics::ConfigFile;
+    use kinematics::robot::EndEffector;
+    use stance::learned::StanceSource;
+    use stance::{Gait, PostProcessParams, WalkRequest, WalkingSpeed};
+    let (robot, _) = common::jvrc1();
+    let file = ConfigFile::load(&common::config_path("jvrc1")).unwrap();
+    let params = PostProcessParams::from_config_for(&file, Gait::Dynamic).unwrap();
+    // JVRC-1's walkd limits ([gait.dynamic] defaults: single support 0.55 s, double 0.25 s).
+    let limits = [[0.55, 1.65], [0.25, 1.0]];
+    let source = StanceSource::Learned {
+        model: Box::new(model().clone()),
+        path: PathBuf::from("default-ngram.json"),
+        beam: None,
+    };
+    let mut steps = Vec::new();
+    for speed in [0.12, 0.24] {
+        let request = WalkRequest {
+            distance: 5.0,
+            affordances: AffordanceSet::Feet,
+            seed: 0,
+            speed: Some(WalkingSpeed {
+                m_s: speed,
+                support_limits_s: limits,
+            }),
+        };
+        let walk = source.walk(robot, &params, &request).unwrap();
+        let stances = walk.stances();
+        let mut time = 0.0;
+        for (i, stance) in stances.iter().enumerate() {
+            let duration = stance.duration_s.expect("every stance is timed");
+            let single = !(stance.contacts[0] && stance.contacts[1]);
+            let [min, max] = limits[usize::from(!single)];
+            // Post-processing may retime a swing it changed (stance::timing), by √ of the change.
+            assert!(
+                (0.5 * min..=2.0 * max).contains(&duration),
+                "{speed} m/s, stance {i}: {duration} s"
+            );
+            if i > 0 && i + 1 < stances.len() {
+                time += duration;
+            }
+        }
+        let feet = |i: usize| {
+            let t = walk.targets(i);
+            (t[EndEffector::LeftFoot as usize].translation.vector
+                + t[EndEffector::RightFoot as usize].translation.vector)
+                / 2.0
+        };
+        let length = (feet(walk.len() - 1) - feet(0)).xy().norm();
+        assert!((length / 5.0 - 1.0).abs() < 0.1, "{speed} m/s: {length} m");
+        let planned = length / time;
+        assert!(
+            (planned / speed - 1.0).abs() < 0.1,
+            "{speed} m/s asked, {planned} m/s planned"
+        );
+        steps.push((stances.len(), time / stances.len() as f64));
+    }
+    let [(slow_stances, slow_time), (fast_stances, fast_time)] = [steps[0], steps[1]];
+    assert!(slow_stances > fast_stances, "{steps:?}");
+    assert!(slow_time > fast_time, "{steps:?}");
 }

@@ -98,6 +98,7 @@ fn a_held_hand_is_refused_in_a_scene_without_a_railing() {
         distance: stairs.path_length(),
         affordances: AffordanceSet::FeetRightHand,
         seed: 1,
+        speed: None,
     };
     let walked = walk_in(robot, params, &request, &stairs.walk_environment(), |o| {
         generate(robot, o)

@@ -56,6 +56,7 @@ pub fn synthetic_walk(robot: &Robot, steps: usize, step: f64, hand: bool) -> Pos
         contacts,
         translation: nalgebra::Vector3::zeros(),
         root_orientation: nalgebra::UnitQuaternion::identity(),
+        duration_s: None,
     };
     let mut stances = vec![stance([true, true, false, false])];
     let mut targets = vec![poses];

@@ -1,7 +1,8 @@
 //! The balance of a dynamic walk over the real processes: walkd's per-tick telemetry
 //! (`<prefix>/telemetry`, read by the observer's [`Source`]) kept on a thread of its own, every
-//! [`KEEP_EVERY`]th tick that carries ZMP and DCM, for the balance row of Fig. 6, and every tick
-//! at which the daemon's state changed (to time a controlled stop to the tick).
+//! [`KEEP_EVERY`]th tick that carries ZMP and DCM, for the balance row of Fig. 6, every tick
+//! at which the daemon's state changed (to time a controlled stop to the tick), and every planned
+//! support phase the dynamic gait entered ([`super::timing`]).
 
 use std::sync::mpsc::Receiver;
 use std::thread::JoinHandle;
@@ -10,6 +11,7 @@ use anyhow::Context;
 use shm_types::{DaemonState, Telemetry};
 
 use super::fig6::BalanceSample;
+use super::timing::PlannedPhase;
 use crate::observe::source::{Batch, Source};
 
 /// One telemetry in this many is kept (at 500 Hz: 100 samples a second).
@@ -31,6 +33,17 @@ pub(crate) struct StateChange {
 struct Kept {
     balance: Vec<Telemetry>,
     changes: Vec<StateChange>,
+    phases: Vec<PlannedPhase>,
+}
+
+/// What a walk's telemetry showed, from the tick it started.
+pub(crate) struct RecordedBalance {
+    /// ZMP and DCM, for Fig. 6.
+    pub samples: Vec<BalanceSample>,
+    /// The daemon's state changes.
+    pub state_changes: Vec<StateChange>,
+    /// The dynamic gait's planned support phases, in order.
+    pub phases: Vec<PlannedPhase>,
 }
 
 /// The ticks and ZMP/DCM of a walk's telemetry, until [`BalanceRecorder::finish`].
@@ -51,12 +64,8 @@ impl BalanceRecorder {
     }
 
     /// Stops recording; the samples from tick `start_tick` on at `rate_hz`, time from there,
-    /// and the state changes from that tick on.
-    pub(crate) fn finish(
-        self,
-        start_tick: u64,
-        rate_hz: f64,
-    ) -> anyhow::Result<(Vec<BalanceSample>, Vec<StateChange>)> {
+    /// the state changes from that tick on, and the planned phases.
+    pub(crate) fn finish(self, start_tick: u64, rate_hz: f64) -> anyhow::Result<RecordedBalance> {
         self.source.stop()?;
         let kept = self
             .collector
@@ -79,12 +88,16 @@ impl BalanceRecorder {
             .into_iter()
             .filter(|c| c.tick >= start_tick)
             .collect();
-        Ok((balance, changes))
+        Ok(RecordedBalance {
+            samples: balance,
+            state_changes: changes,
+            phases: kept.phases,
+        })
     }
 }
 
-/// Keeps every [`KEEP_EVERY`]th telemetry with ZMP and DCM, and every state change, until the
-/// batches end.
+/// Keeps every [`KEEP_EVERY`]th telemetry with ZMP and DCM, every state change and every new
+/// planned phase, until the batches end.
 fn collect(batches: &Receiver<Batch>) -> Kept {
     let mut kept = Kept::default();
     let mut state = None;
@@ -98,6 +111,10 @@ fn collect(batches: &Receiver<Batch>) -> Kept {
                     sample_timestamp_ns: telemetry.sample_timestamp_ns,
                     state,
                 }));
+            }
+            let phase = PlannedPhase::of(&telemetry);
+            if phase.is_some() && phase.as_ref() != kept.phases.last() {
+                kept.phases.extend(phase);
             }
             if telemetry.dynamics_valid.is_set() && telemetry.tick % KEEP_EVERY == 0 {
                 kept.balance.push(telemetry);

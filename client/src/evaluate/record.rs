@@ -62,6 +62,7 @@ impl MatrixCells {
                         distance,
                         affordances,
                         seed: self.first_seed + i,
+                        speed: None,
                     })
                 })
             })

@@ -13,6 +13,7 @@ use shm_types::{DaemonStatus, SimTruth};
 use stance::PostProcessedSequence;
 
 use super::balance::{BalanceRecorder, StateChange};
+use super::timing::PlannedPhase;
 use super::truth::{TruthRecorder, Verdict, state_at};
 use super::{BalanceSample, Points, TraceSample, align_targets};
 use crate::daemon_client::DaemonClient;
@@ -67,6 +68,8 @@ pub(crate) struct WatchedWalk {
     pub balance: Vec<BalanceSample>,
     /// The ticks at which the daemon's state changed, with [`WatchOptions::balance`].
     pub state_changes: Vec<StateChange>,
+    /// The dynamic gait's planned support phases, with [`WatchOptions::balance`].
+    pub(crate) phases: Vec<PlannedPhase>,
     /// The recording, with [`WatchOptions::record`].
     pub recording: Option<RecorderOutcome>,
 }
@@ -117,9 +120,12 @@ pub(crate) fn watch_walk(
     std::thread::sleep(options.linger);
     let recording = observer.map(Recorder::finish).transpose()?;
     let states = recorder.finish()?;
-    let (balance, state_changes) = match balance {
-        Some(recorder) => recorder.finish(start.ticks, start.rate_hz)?,
-        None => (Vec::new(), Vec::new()),
+    let (balance, state_changes, phases) = match balance {
+        Some(recorder) => {
+            let recorded = recorder.finish(start.ticks, start.rate_hz)?;
+            (recorded.samples, recorded.state_changes, recorded.phases)
+        }
+        None => Default::default(),
     };
     let drift = pair_with_truth(&mut trace, &status_times, &states);
     // Simulated time from the submission to the tick of the last status: by the simulator's
@@ -146,6 +152,7 @@ pub(crate) fn watch_walk(
         drift,
         balance,
         state_changes,
+        phases,
         recording,
     })
 }

@@ -395,6 +395,8 @@ fn tick_message(telemetry: &Telemetry, stamp: Timestamp) -> WalkTick {
         zmp_measured: planar(&telemetry.zmp_measured),
         dcm_reference: planar(&telemetry.dcm_reference),
         dcm_measured: planar(&telemetry.dcm_measured),
+        phase_duration_s: telemetry.phase_duration_s,
+        phase_timing: telemetry.phase_timing.name().to_owned(),
         compute_us: telemetry.compute_ns as f64 / 1e3,
         latency_us: if commanded {
             telemetry

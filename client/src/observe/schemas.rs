@@ -45,6 +45,11 @@ pub struct WalkTick {
     pub dcm_reference: Vector3,
     /// Measured DCM (z = 0).
     pub dcm_measured: Vector3,
+    /// Planned duration of the dynamic gait's current phase (s; 0 outside a planned phase).
+    pub phase_duration_s: f64,
+    /// Where that duration came from: `sequence`, `clamped` (the sequence's, moved into the
+    /// config's limits), `config`, or `none`.
+    pub phase_timing: String,
     /// Controller compute time (µs).
     pub compute_us: f64,
     /// Sample time stamp → command sent (µs; 0 without a command).

@@ -61,7 +61,7 @@ pub use sequence::{PreparedSequence, Refusal};
 pub use stance::Gait;
 pub use status::{
     BalanceStatus, ControllerState, ControllerStatus, FaultCode, FaultDescription,
-    MeasurementFault, Phase,
+    MeasurementFault, Phase, PhaseTiming, PlannedPhase,
 };
 pub use telemetry::ControllerTelemetry;
 

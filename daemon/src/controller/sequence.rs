@@ -24,6 +24,9 @@ pub(crate) struct PreparedStance {
     pub contacts: [bool; 4],
     /// Target poses by `EndEffector`, in the sequence's world frame.
     pub targets: [Isometry3<f64>; 4],
+    /// How long the walk stays in this stance (s, from the demonstrations; `None`: untimed). The
+    /// dynamic gait times its phases by it within the config's limits.
+    pub duration_s: Option<f64>,
 }
 
 /// A validated sequence ready for [`super::Controller::start`]; building it may allocate, so it is
@@ -117,6 +120,7 @@ impl PreparedSequence {
                 posture: DVector::from_column_slice(posture),
                 contacts,
                 targets: targets.map(|t| Isometry3::from_parts(t.translation, t.rotation)),
+                duration_s: seq.stances()[i].duration_s,
             });
         }
         check_step_sizes(&stances, config.max_step_m)?;

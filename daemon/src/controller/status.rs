@@ -318,4 +318,60 @@ pub struct BalanceStatus {
     pub dcm_measured: [f64; 2],
     /// The estimated CoM model error, true minus model (the ZMP offset).
     pub com_offset: [f64; 2],
+    /// The footstep-plan phase under way as planned (`None` while settling), so a client sees
+    /// whether the step times come from the sequence.
+    pub planned_phase: Option<PlannedPhase>,
+}
+
+/// A dynamic-gait phase as the footstep plan timed it.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct PlannedPhase {
+    /// Its planned duration (s).
+    pub duration_s: f64,
+    /// Where that duration came from.
+    pub timing: PhaseTiming,
+}
+
+/// Where a dynamic-gait phase's duration came from: a timed sequence sets the pace of the steps
+/// it times, within the config's limits (docs/controller.md, "Footstep plan").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PhaseTiming {
+    /// The config's duration: an untimed stance in its span, or a phase the sequence does not
+    /// time (hand transitions, the final and the stop's double support).
+    #[default]
+    Configured,
+    /// The sum of its stances' durations, as the sequence gave them.
+    Sequence,
+    /// The sum of its stances' durations, moved into the config's limits.
+    Clamped,
+}
+
+impl PhaseTiming {
+    /// Lower-case name for logs and telemetry (`config`, `sequence`, `clamped`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Configured => "config",
+            Self::Sequence => "sequence",
+            Self::Clamped => "clamped",
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The telemetry carries a timing as the wire code of its name (runtime/telemetry.rs).
+    #[test]
+    fn phase_timings_have_their_wire_names() {
+        let timings = [
+            PhaseTiming::Configured,
+            PhaseTiming::Sequence,
+            PhaseTiming::Clamped,
+        ];
+        assert_eq!(
+            timings.map(PhaseTiming::name),
+            ["config", "sequence", "clamped"]
+        );
+    }
 }

@@ -2,10 +2,10 @@
 //! [`ControllerTelemetry`](crate::controller::ControllerTelemetry) (the loop adds its
 //! bookkeeping). Allocation-free: it runs on the control thread, after the tick's command was sent.
 
-use shm_types::{Code, DaemonState, Flag, SUPPORT_VERTICES, Telemetry, WalkPhase};
+use shm_types::{Code, DaemonState, Flag, SUPPORT_VERTICES, Telemetry, TimingSource, WalkPhase};
 use stance::Gait;
 
-use crate::controller::{BalanceStatus, ControllerTelemetry, Phase};
+use crate::controller::{BalanceStatus, ControllerStatus, ControllerTelemetry, Phase, PhaseTiming};
 
 /// Writes the daemon's `state` and what the `controller` estimated and aimed at into `out`:
 /// every field but the loop's bookkeeping (`seq` to `deadline_misses`, which the loop writes), so
@@ -42,6 +42,31 @@ pub(super) fn fill(out: &mut Telemetry, state: DaemonState, controller: &Control
     out.zmp_measured = balance.zmp_measured;
     out.dcm_reference = balance.dcm_reference;
     out.dcm_measured = balance.dcm_measured;
+    let (duration_s, timing) = planned_phase(status, dynamic);
+    out.phase_duration_s = duration_s;
+    out.phase_timing = Code::new(timing);
+}
+
+/// The planned duration of the footstep-plan phase under way and its source; none outside one
+/// (the static gait, not executing, settling).
+fn planned_phase(status: &ControllerStatus, dynamic: bool) -> (f64, TimingSource) {
+    let in_plan = matches!(
+        status.phase,
+        Phase::DoubleSupport | Phase::SingleSupport | Phase::LateTouchdown | Phase::LateLiftOff
+    );
+    match status.balance.planned_phase {
+        Some(planned) if dynamic && in_plan => (planned.duration_s, wire_timing(planned.timing)),
+        _ => (0.0, TimingSource::None),
+    }
+}
+
+/// The wire code of a phase's timing source.
+fn wire_timing(timing: PhaseTiming) -> TimingSource {
+    match timing {
+        PhaseTiming::Configured => TimingSource::Config,
+        PhaseTiming::Sequence => TimingSource::Sequence,
+        PhaseTiming::Clamped => TimingSource::Clamped,
+    }
 }
 
 /// The wire code of a controller phase.
@@ -84,5 +109,30 @@ mod tests {
         ] {
             assert_eq!(wire_phase(phase).name(), phase.name());
         }
+    }
+
+    #[test]
+    fn every_timing_has_the_wire_code_of_its_name() {
+        for timing in [
+            PhaseTiming::Configured,
+            PhaseTiming::Sequence,
+            PhaseTiming::Clamped,
+        ] {
+            assert_eq!(wire_timing(timing).name(), timing.name());
+        }
+    }
+
+    #[test]
+    fn a_planned_phase_shows_only_while_the_dynamic_gait_walks_it() {
+        let mut status = ControllerStatus {
+            phase: Phase::SingleSupport,
+            ..ControllerStatus::default()
+        };
+        status.balance.planned_phase = Some(Default::default());
+        status.balance.planned_phase.as_mut().unwrap().duration_s = 0.8;
+        assert_eq!(planned_phase(&status, true), (0.8, TimingSource::Config));
+        assert_eq!(planned_phase(&status, false), (0.0, TimingSource::None));
+        status.phase = Phase::Settle;
+        assert_eq!(planned_phase(&status, true), (0.0, TimingSource::None));
     }
 }

@@ -115,6 +115,12 @@ pub enum GenerateError {
     /// The generated sequence failed validation (a bug).
     #[error("generated sequence is invalid: {0}")]
     Invalid(FormatError),
+    /// A walking speed was asked of the synthetic generator, which has no human timing.
+    #[error(
+        "a walking speed needs the learned source (--model MODEL.json): the synthetic \
+         generator has no human timing"
+    )]
+    SpeedNeedsModel,
 }
 
 impl From<FormatError> for GenerateError {

@@ -9,7 +9,7 @@
 //! ("Realism against the held-out walker") for the definitions.
 
 use kinematics::ground::GRAVITY as G;
-use nalgebra::{Vector2, Vector3};
+use nalgebra::Vector3;
 
 use super::demo::{Demonstration, EventKind};
 use super::error::LearnError;
@@ -27,19 +27,19 @@ const BEAM_WIDTH: usize = 8;
 /// Number of sampled sequences (seeds 0, 1, …) pooled in the comparison.
 const SAMPLES: u64 = 10;
 
-/// A foot strike (`strike`) or foot off of `foot` at `time` (s), with the horizontal heel
-/// position (m) at a strike.
+/// A foot strike (`strike`) or foot off of `foot` at `time` (s), with the heel position (m) at
+/// a strike (steps use its horizontal part; `gait_law` its height, to tell level walking).
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct FootEvent {
-    foot: usize,
-    strike: bool,
-    time: f64,
-    heel: Vector2<f64>,
+pub(crate) struct FootEvent {
+    pub(crate) foot: usize,
+    pub(crate) strike: bool,
+    pub(crate) time: f64,
+    pub(crate) heel: Vector3<f64>,
 }
 
 /// One complete step, from a strike of one foot to the next strike of the other.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Step {
+pub(crate) struct Step {
     /// Step length and width (m) along the walking direction; `None` when no stride around the
     /// step gives a direction.
     along: Option<(f64, f64)>,
@@ -58,7 +58,7 @@ struct Step {
 /// The walking direction of a step is its striking foot's stride (heel at its previous strike to
 /// heel at this one), or where that strike is the first, the stride of the foot it steps past
 /// (from the strike opening the step to that foot's next strike).
-fn steps(events: &[FootEvent], leg_length: f64) -> Vec<Step> {
+pub(crate) fn steps(events: &[FootEvent], leg_length: f64) -> Vec<Step> {
     let mut strikes: Vec<&FootEvent> = events.iter().filter(|e| e.strike).collect();
     strikes.sort_by(|a, b| a.time.total_cmp(&b.time));
     let mut steps = Vec::new();
@@ -75,14 +75,14 @@ fn steps(events: &[FootEvent], leg_length: f64) -> Vec<Step> {
         let Some(off) = off else {
             continue;
         };
-        let before =
-            (i >= 2 && strikes[i - 2].foot == to.foot).then(|| to.heel - strikes[i - 2].heel);
+        let before = (i >= 2 && strikes[i - 2].foot == to.foot)
+            .then(|| (to.heel - strikes[i - 2].heel).xy());
         let after = strikes
             .get(i + 1)
             .filter(|e| e.foot == from.foot)
-            .map(|e| e.heel - from.heel);
+            .map(|e| (e.heel - from.heel).xy());
         let direction = before.or(after).and_then(|d| d.try_normalize(1e-9));
-        let d = to.heel - from.heel;
+        let d = (to.heel - from.heel).xy();
         steps.push(Step {
             along: direction.map(|u| (d.dot(&u), (u.x * d.y - u.y * d.x).abs())),
             time: to.time - from.time,
@@ -96,7 +96,7 @@ fn steps(events: &[FootEvent], leg_length: f64) -> Vec<Step> {
 
 /// Foot strikes and offs of a demonstration as the segmentation (default thresholds, as
 /// training uses) detects them, with the heel at each strike.
-fn demonstration_events(demo: &Demonstration) -> Vec<FootEvent> {
+pub(crate) fn demonstration_events(demo: &Demonstration) -> Vec<FootEvent> {
     let contacts = segment(demo, &SegmentOptions::default()).contacts;
     foot_events(&contacts, demo.rate)
         .into_iter()
@@ -106,7 +106,7 @@ fn demonstration_events(demo: &Demonstration) -> Vec<FootEvent> {
                 foot: e.foot,
                 strike: e.kind == EventKind::FootStrike,
                 time: e.time,
-                heel: demo.feet[e.foot][frame][0].xy(),
+                heel: demo.feet[e.foot][frame][0],
             }
         })
         .collect()
@@ -117,7 +117,7 @@ fn demonstration_events(demo: &Demonstration) -> Vec<FootEvent> {
 struct PlacedStance {
     feet_down: [bool; 2],
     duration: f64,
-    feet: [Vector2<f64>; 2],
+    feet: [Vector3<f64>; 2],
 }
 
 /// Foot strikes (a foot down that was not in the previous stance) and offs of a stance
@@ -158,7 +158,7 @@ fn placed(model: &NgramModel, generated: &Generated) -> Vec<PlacedStance> {
                 root += Vector3::from(token.translation);
             }
             let foot = |f: usize| {
-                (root + Vector3::from(token.effectors[f].expect("feet are posed").position)).xy()
+                root + Vector3::from(token.effectors[f].expect("feet are posed").position)
             };
             PlacedStance {
                 feet_down: [token.contacts[0], token.contacts[1]],
@@ -258,7 +258,8 @@ pub struct WalkStatistics {
 }
 
 impl WalkStatistics {
-    fn of(steps: &[Step]) -> Self {
+    /// The statistics of `steps` (also the per-walker medians of `gait_law`).
+    pub(crate) fn of(steps: &[Step]) -> Self {
         let leg: Vec<f64> = steps.iter().map(|s| s.leg_length).collect();
         let time = |t: f64, s: &Step| (t, t * (G / s.leg_length).sqrt());
         let along = || {
@@ -509,7 +510,7 @@ mod tests {
             foot,
             strike,
             time,
-            heel: Vector2::new(time, 0.0),
+            heel: Vector3::new(time, 0.0, 0.0),
         };
         // Left strike, right strike with no right foot-off between (missed detection), then a
         // complete step: right off, left strike.
@@ -531,7 +532,7 @@ mod tests {
     #[test]
     fn generated_stances_give_steps_from_their_durations_and_feet() {
         let mut stances = Vec::new();
-        let mut feet = [Vector2::new(0.0, 0.05), Vector2::new(0.0, -0.05)];
+        let mut feet = [Vector3::new(0.0, 0.05, 0.0), Vector3::new(0.0, -0.05, 0.0)];
         for k in 0..8 {
             stances.push(PlacedStance {
                 feet_down: [true, true],

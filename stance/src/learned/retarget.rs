@@ -10,12 +10,19 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use super::error::LearnError;
 use super::model::NgramModel;
+use super::pace::{Pace, RobotGait, SpeedRequest};
 use super::query::{Generated, Query, Search, generate_tokens};
 use crate::environment::{Environment, HandAffordance};
 use crate::generate::AffordanceSet;
 use crate::generate::standing::Standing;
 use crate::sequence::{RawSequence, Stance};
 use crate::stance_ik::StanceIk;
+
+/// Rounds of generating a paced walk and setting its stretch ([`generate_learned`]).
+const PACE_ROUNDS: usize = 4;
+
+/// A stretch within this relative difference of the one the walk was generated for is kept.
+const PACE_TOLERANCE: f64 = 0.03;
 
 /// What to generate with a learned model.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,12 +37,19 @@ pub struct LearnedOptions {
     pub railing: Option<[f64; 2]>,
     /// Beam search (most probable) or seeded sampling.
     pub search: Search,
+    /// A walking speed to pace the walk for; `None`: the human pace at the robot's size
+    /// ([`super::pace`]).
+    pub speed: Option<SpeedRequest>,
 }
 
 /// The robot's walking frame and size, measured in its standing posture.
 struct RobotFrame {
     /// Human-to-robot length scale.
     scale: f64,
+    /// The robot's leg length: its standing pelvis height above the soles (m).
+    leg_length: f64,
+    /// Factor on the human path's forward lengths ([`Pace::stretch`]).
+    stretch: f64,
     /// Unit walking direction (horizontal).
     forward: Vector3<f64>,
     /// Standing hand orientations in the world.
@@ -47,6 +61,8 @@ impl RobotFrame {
         let standing = Standing::measure(robot);
         Self {
             scale: standing.pelvis_height / human_pelvis_height,
+            leg_length: standing.pelvis_height,
+            stretch: 1.0,
             forward: standing.forward,
             hand_rotations: [
                 standing.pose(EndEffector::LeftHand).rotation,
@@ -59,21 +75,29 @@ impl RobotFrame {
         self.forward.y.atan2(self.forward.x)
     }
 
-    /// World point of human path coordinates (along, lateral, height), scaled.
+    /// World point of human path coordinates (along, lateral, height), scaled (and stretched
+    /// along the path).
     fn point(&self, human: Vector3<f64>) -> Vector3<f64> {
         let lateral = Vector3::z().cross(&self.forward);
-        (self.forward * human.x + lateral * human.y + Vector3::z() * human.z) * self.scale
+        (self.forward * human.x * self.stretch + lateral * human.y + Vector3::z() * human.z)
+            * self.scale
     }
 }
 
-/// Per-stance world targets (robot scale) of a generated token sequence.
+/// Per-stance world targets (robot scale) of a generated token sequence, and its duration.
 struct StanceTargets {
     contacts: [bool; 4],
     targets: [Option<Isometry3<f64>>; 4],
     root: Vector3<f64>,
+    duration_s: f64,
 }
 
-fn lay_out(model: &NgramModel, generated: &Generated, frame: &RobotFrame) -> Vec<StanceTargets> {
+fn lay_out(
+    model: &NgramModel,
+    generated: &Generated,
+    frame: &RobotFrame,
+    pace: &Pace,
+) -> Vec<StanceTargets> {
     let heading = frame.heading();
     generated
         .tokens
@@ -118,6 +142,7 @@ fn lay_out(model: &NgramModel, generated: &Generated, frame: &RobotFrame) -> Vec
                 contacts,
                 targets,
                 root: frame.point(root),
+                duration_s: pace.duration(token),
             }
         })
         .collect()
@@ -142,25 +167,59 @@ pub struct Retargeted {
     pub generated: Generated,
     /// Per stance, the IK's remaining `[position error (m), orientation error (rad)]`.
     pub ik_errors: Vec<[f64; 2]>,
+    /// With a speed request: what the gait law asked of the robot.
+    pub gait: Option<RobotGait>,
 }
 
 /// Generates a raw stance sequence for `robot` from a learned model: query (human scale),
-/// lay-out, per-stance IK.
+/// pace ([`super::pace`]), lay-out, per-stance IK. The stances carry their durations.
 pub fn generate_learned(
     robot: &Robot,
     model: &NgramModel,
     options: &LearnedOptions,
 ) -> Result<Retargeted, LearnError> {
-    let frame = RobotFrame::measure(robot, model.human_pelvis_height);
-    let human_distance = options.distance / frame.scale;
+    let mut frame = RobotFrame::measure(robot, model.human_pelvis_height);
     let railing = options.railing.unwrap_or([0.0, options.distance]);
-    let query = Query {
-        distance: human_distance,
-        hands: hand_intervals(options.affordances, railing.map(|s| s / frame.scale)),
+    // Human path metres before the stretch: the stretched walk covers the distance.
+    let query = |stretch: f64| Query {
+        distance: options.distance / frame.scale / stretch,
+        hands: hand_intervals(
+            options.affordances,
+            railing.map(|s| s / frame.scale / stretch),
+        ),
         search: options.search,
     };
-    let generated = generate_tokens(model, &query)?;
-    let layout = lay_out(model, &generated, &frame);
+    let (generated, pace, gait) = match options.speed {
+        None => (
+            generate_tokens(model, &query(1.0))?,
+            Pace::similar(frame.scale),
+            None,
+        ),
+        Some(request) => {
+            let gait = RobotGait::of(model, frame.leg_length, request.speed.m_s)?;
+            // The stretch depends on the walk's own stances, and the walk on the distance it
+            // is asked for, which the stretch sets: a few rounds bring them together. The walk
+            // is laid out at the stretch it was generated for (so it covers the distance), its
+            // times corrected by what is left between the two (so it walks at the speed).
+            let mut stretch = 1.0;
+            let mut walk = None;
+            for _ in 0..PACE_ROUNDS {
+                let generated = generate_tokens(model, &query(stretch))?;
+                let pace = Pace::for_speed(model, &generated, &gait, request, frame.scale)?;
+                let settled = (pace.stretch / stretch - 1.0).abs() < PACE_TOLERANCE;
+                let next = pace.stretch;
+                walk = Some((generated, pace.at_stretch(stretch)));
+                if settled {
+                    break;
+                }
+                stretch = next;
+            }
+            let (generated, pace) = walk.expect("at least one round");
+            (generated, pace, Some(gait))
+        }
+    };
+    frame.stretch = pace.stretch;
+    let layout = lay_out(model, &generated, &frame, &pace);
     let (stances, ik_errors) = solve(robot, &layout)?;
     let environment = environment(&layout, options, &frame);
     let raw = RawSequence::new(
@@ -173,6 +232,7 @@ pub fn generate_learned(
     Ok(Retargeted {
         raw,
         generated,
+        gait,
         ik_errors,
     })
 }
@@ -234,7 +294,10 @@ fn solve(
             .solve(&stance.targets, stance.contacts, &initial)
             .map_err(|error| LearnError::Retarget(format!("stance {i}: {error}")))?;
         errors.push(solved.errors);
-        stances.push(solved.stance);
+        stances.push(Stance {
+            duration_s: Some(stance.duration_s),
+            ..solved.stance
+        });
         current_root = stance.root;
     }
     Ok((stances, errors))

@@ -10,12 +10,14 @@ use kinematics::robot::Robot;
 
 use super::error::LearnError;
 use super::model::NgramModel;
+use super::pace::{RobotGait, SpeedRequest};
 use super::query::Search;
 use super::retarget::{LearnedOptions, generate_learned};
+use crate::environment::Environment;
 use crate::generate::{GenerateError, GenerateOptions, generate_with_railing};
 use crate::params::PostProcessParams;
 use crate::sequence::{PostProcessedSequence, RawSequence};
-use crate::walk::{WalkError, WalkRequest, walk_with};
+use crate::walk::{WalkError, WalkRequest, walk_in, walk_with};
 
 /// Which generator a command uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -128,6 +130,8 @@ pub struct Sourced {
     pub raw: RawSequence,
     /// Largest retargeting residual (learned source only).
     pub largest_ik_error: Option<[f64; 2]>,
+    /// With a speed request: what the gait law asked of the robot.
+    pub gait: Option<RobotGait>,
 }
 
 impl SourceArgs {
@@ -184,24 +188,44 @@ impl StanceSource {
         request: &WalkRequest,
     ) -> Result<PostProcessedSequence, WalkError<SourceError>> {
         walk_with(robot, params, request, |options| {
-            Ok(self.generate(robot, options, None)?.raw)
+            Ok(self
+                .generate(robot, options, None, speed_request(request, params))?
+                .raw)
+        })
+    }
+
+    /// [`StanceSource::walk`] through `environment` ([`walk_in`]: a scene's, in the walk's frame).
+    pub fn walk_in(
+        &self,
+        robot: &Robot,
+        params: &PostProcessParams,
+        request: &WalkRequest,
+        environment: &Environment,
+    ) -> Result<PostProcessedSequence, WalkError<SourceError>> {
+        walk_in(robot, params, request, environment, |options| {
+            Ok(self
+                .generate(robot, options, None, speed_request(request, params))?
+                .raw)
         })
     }
 
     /// Generates a raw sequence covering `options.distance` (raw-scale metres: divide by scf
     /// first to cover a distance after post-processing), the railing available over `railing`
-    /// (same scale; `None` = the whole walk).
+    /// (same scale; `None` = the whole walk), paced for `speed` if asked (learned source only).
     pub fn generate(
         &self,
         robot: &Robot,
         options: &GenerateOptions,
         railing: Option<[f64; 2]>,
+        speed: Option<SpeedRequest>,
     ) -> Result<Sourced, SourceError> {
         let railing = railing.unwrap_or([0.0, options.distance]);
         match self {
+            Self::Synthetic if speed.is_some() => Err(GenerateError::SpeedNeedsModel.into()),
             Self::Synthetic => Ok(Sourced {
                 raw: generate_with_railing(robot, options, railing)?,
                 largest_ik_error: None,
+                gait: None,
             }),
             Self::Learned { model, beam, .. } => {
                 let learned = LearnedOptions {
@@ -209,6 +233,7 @@ impl StanceSource {
                     affordances: options.affordances,
                     railing: Some(railing),
                     search: beam.map_or(Search::Sample(options.seed), Search::Beam),
+                    speed,
                 };
                 let retargeted = generate_learned(robot, model, &learned)?;
                 let largest = retargeted
@@ -218,10 +243,19 @@ impl StanceSource {
                 Ok(Sourced {
                     raw: retargeted.raw,
                     largest_ik_error: Some(largest),
+                    gait: retargeted.gait,
                 })
             }
         }
     }
+}
+
+/// The speed `request` asks for, with the `scf` its post-processing will shorten the steps by.
+fn speed_request(request: &WalkRequest, params: &PostProcessParams) -> Option<SpeedRequest> {
+    request.speed.map(|speed| SpeedRequest {
+        speed,
+        scf: params.scf,
+    })
 }
 
 #[cfg(test)]

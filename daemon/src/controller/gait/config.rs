@@ -9,7 +9,7 @@ use serde::Deserialize;
 use stance::{Gait, GaitUnavailable};
 
 use kinematics::ConfigFile;
-use kinematics::bounds::Bound;
+use kinematics::bounds::{Bound, Number, Range};
 use kinematics::config_file::toml_message;
 
 use crate::controller::config::{ConfigError, check};
@@ -53,6 +53,15 @@ pub struct DynamicGaitConfig {
     pub stop_double_support_s: f64,
     /// A transition that changes only hand contacts: the hands reach, the feet stay (s).
     pub hand_transition_s: f64,
+    /// `[min, max]` of a single support a timed sequence sets (the sum of the durations of the
+    /// stances its foot swings through, s); absent: `single_support_s` to
+    /// [`TIMED_SINGLE_SUPPORT_MAX_FACTOR`] × `single_support_s`, so a sequence may slow the tuned
+    /// gait down but never step faster than the timing the robot was tuned for.
+    pub timed_single_support_s: Option<[f64; 2]>,
+    /// `[min, max]` of a double support before a lift-off a timed sequence sets (the sum of the
+    /// durations of the stances on both feet since the support's previous phase, s); absent:
+    /// `double_support_s` to [`TIMED_DOUBLE_SUPPORT_MAX_FACTOR`] × `double_support_s`.
+    pub timed_double_support_s: Option<[f64; 2]>,
     /// Height of the CoM above the support surface, the pendulum length `h` of ω² = g / h (m);
     /// absent: the CoM height of the standing posture.
     pub com_height_m: Option<f64>,
@@ -99,6 +108,14 @@ pub struct DynamicGaitConfig {
 /// it tipped, 0/4.
 pub const STEP_SINGLE_SUPPORT_FACTOR: f64 = 2.0;
 
+/// The longest single support a timed sequence gets unless configured, relative to
+/// `single_support_s`: a human-paced step slows the gait down at most this much.
+pub const TIMED_SINGLE_SUPPORT_MAX_FACTOR: f64 = 3.0;
+
+/// The longest double support a timed sequence gets unless configured, relative to
+/// `double_support_s` (a pause on both feet between steps).
+pub const TIMED_DOUBLE_SUPPORT_MAX_FACTOR: f64 = 4.0;
+
 /// The tuning that walks JVRC-1 under MuJoCo (configs/jvrc1.toml, 0.26 m/s), so an empty
 /// `[gait.dynamic]` walks an HRP-class robot; `walkctl init-robot` derives a robot's own.
 impl Default for DynamicGaitConfig {
@@ -111,6 +128,8 @@ impl Default for DynamicGaitConfig {
             final_double_support_s: 1.0,
             stop_double_support_s: 0.6,
             hand_transition_s: 0.5,
+            timed_single_support_s: None,
+            timed_double_support_s: None,
             com_height_m: None,
             landing_depth_m: 0.001,
             early_touchdown_s: 0.1,
@@ -321,11 +340,32 @@ impl DynamicGaitConfig {
             .unwrap_or(STEP_SINGLE_SUPPORT_FACTOR * self.single_support_s)
     }
 
+    /// The limits of a single support timed by the sequence (`timed_single_support_s` or its
+    /// default).
+    pub fn timed_single_support(&self) -> [f64; 2] {
+        self.timed_single_support_s.unwrap_or([
+            self.single_support_s,
+            TIMED_SINGLE_SUPPORT_MAX_FACTOR * self.single_support_s,
+        ])
+    }
+
+    /// The limits of a double support timed by the sequence (`timed_double_support_s` or its
+    /// default).
+    pub fn timed_double_support(&self) -> [f64; 2] {
+        self.timed_double_support_s.unwrap_or([
+            self.double_support_s,
+            TIMED_DOUBLE_SUPPORT_MAX_FACTOR * self.double_support_s,
+        ])
+    }
+
     /// Checks every value against its documented range (docs/controller.md, "Dynamic gait");
     /// `origin` names the file in the error.
     pub fn validate(&self, origin: &str) -> Result<(), ConfigError> {
         check(&self.bounds(), origin, DYNAMIC)?;
         check(&self.stabilizer.bounds(), origin, STABILIZER)?;
+        for (key, limits, range) in self.timed_limits() {
+            check_limits(key, limits, range, origin)?;
+        }
         if self.early_touchdown_s >= self.single_support_s {
             return Err(ConfigError::Value {
                 origin: origin.to_owned(),
@@ -336,6 +376,23 @@ impl DynamicGaitConfig {
             });
         }
         Ok(())
+    }
+
+    /// The `[min, max]` keys of `[gait.dynamic]`: each key, its limits and the range each limit
+    /// must lie in (not in [`Self::bounds`], whose keys are single numbers).
+    fn timed_limits(&self) -> [(&'static str, Option<[f64; 2]>, Range); 2] {
+        [
+            (
+                "timed_single_support_s",
+                self.timed_single_support_s,
+                Range::new(0.1, 10.0),
+            ),
+            (
+                "timed_double_support_s",
+                self.timed_double_support_s,
+                Range::new(0.01, 10.0),
+            ),
+        ]
     }
 
     /// The `[gait.dynamic]` table: every numeric key, its value and its range, one line a key.
@@ -379,6 +436,31 @@ impl DynamicGaitConfig {
             Bound::optional("torso_posture_weight", self.torso_posture_weight, 1e-6, 1e6),
         ]
     }
+}
+
+/// A `[min, max]` key of `[gait.dynamic]`, if given, holds min ≤ max, both in `range` (so
+/// finite and positive).
+fn check_limits(
+    key: &str,
+    limits: Option<[f64; 2]>,
+    range: Range,
+    origin: &str,
+) -> Result<(), ConfigError> {
+    let Some([min, max]) = limits else {
+        return Ok(());
+    };
+    if range.contains(min) && range.contains(max) && min <= max {
+        return Ok(());
+    }
+    Err(ConfigError::Section {
+        origin: origin.to_owned(),
+        section: DYNAMIC,
+        message: format!(
+            "{key} = [{}, {}]: must be [min, max] with min ≤ max, each in {range} (s)",
+            Number(min),
+            Number(max)
+        ),
+    })
 }
 
 impl StabilizerConfig {
@@ -531,6 +613,50 @@ mod tests {
                 .expect_err(key)
                 .to_string();
             assert!(error.contains(&format!("[{table}] {key}")), "{error}");
+        }
+    }
+
+    #[test]
+    fn timed_limits_default_to_slowing_the_tuned_gait_down_only() {
+        let config =
+            parse("[gait.dynamic]\nsingle_support_s = 0.6\ndouble_support_s = 0.2\n").unwrap();
+        let dynamic = config.dynamic().unwrap();
+        assert_eq!(dynamic.timed_single_support(), [0.6, 3.0 * 0.6]);
+        assert_eq!(dynamic.timed_double_support(), [0.2, 4.0 * 0.2]);
+        let config = parse(
+            "[gait.dynamic]\ntimed_single_support_s = [0.4, 1.2]\n\
+             timed_double_support_s = [0.1, 0.5]\n",
+        )
+        .unwrap();
+        let dynamic = config.dynamic().unwrap();
+        assert_eq!(dynamic.timed_single_support(), [0.4, 1.2]);
+        assert_eq!(dynamic.timed_double_support(), [0.1, 0.5]);
+    }
+
+    #[test]
+    fn bad_timed_limits_are_refused_naming_the_key() {
+        for key in ["timed_single_support_s", "timed_double_support_s"] {
+            for limits in [
+                "[0.9, 0.5]",
+                "[nan, 1.0]",
+                "[0.5, inf]",
+                "[-0.5, 1.0]",
+                "[0.5, 1e9]",
+            ] {
+                let error = parse(&format!("[gait.dynamic]\n{key} = {limits}\n"))
+                    .expect_err(limits)
+                    .to_string();
+                assert!(
+                    error.contains("robot.toml") && error.contains(&format!("{key} = [")),
+                    "{error}"
+                );
+            }
+            for malformed in ["0.5", "[0.5]", "[0.5, 1.0, 2.0]"] {
+                let error = parse(&format!("[gait.dynamic]\n{key} = {malformed}\n"))
+                    .expect_err(malformed)
+                    .to_string();
+                assert!(error.contains(key), "{error}");
+            }
         }
     }
 

@@ -364,6 +364,7 @@ mod tests {
                 posture: DVector::zeros(1),
                 contacts,
                 targets,
+                duration_s: None,
             }
         };
         let standing = feet;

@@ -52,6 +52,7 @@ mod tests {
             start_s,
             duration_s: 1.0,
             feet: feet.map(|z| z.map(|z| Isometry3::translation(0.0, 0.0, z))),
+            timing: crate::controller::status::PhaseTiming::Configured,
         }
     }
 

@@ -1,16 +1,25 @@
 //! The footstep plan: a sequence's foot-contact changes as timed support phases.
 //!
 //! Walking the stances in order from both feet standing, every change of the feet in contact
-//! becomes phases of the configured durations:
+//! becomes phases:
 //! - a foot released (double → single support): a double-support phase (the ZMP crosses to the
-//!   foot that stays), at whose end the foot lifts off; the first one lasts
-//!   `initial_double_support_s`, so the CoM can start from rest;
+//!   foot that stays), at whose end the foot lifts off; it lasts `double_support_s`, the first
+//!   one `initial_double_support_s`, so the CoM can start from rest;
 //! - a foot added (single → double support): the single-support phase in which it swings, from
 //!   lift-off through the highest post-processed swing pose of its flight to its contact pose;
+//!   it lasts `single_support_s` (a step up or down: `step_single_support_s`);
 //! - a foot added and the other released at once (single support on one foot, then on the
-//!   other): that swing, then a double support before the lift-off;
+//!   other): that swing, then a double support of `double_support_s` before the lift-off;
 //! - only hands change: a double support of `hand_transition_s` while they reach;
 //! - nothing changes (repeated stances, or a swing passing another swing pose): no phase.
+//!
+//! A timed sequence sets the pace instead: a double support before a lift-off lasts the summed
+//! durations of the stances the walk stood in on both feet since the support's previous phase,
+//! a single support those of the stances its foot was in the air, each clamped into
+//! `timed_double_support_s` / `timed_single_support_s` (the first lift-off and a step up or down
+//! no shorter than their configured durations). A span with an untimed stance, and every other
+//! phase, keeps the configured duration; each phase records where its duration came from
+//! ([`PhaseTiming`]).
 //!
 //! The walk ends with `final_double_support_s` of double support after the last touchdown; a
 //! sequence ending with a foot in the air is refused. The phases of each stance form a
@@ -24,6 +33,7 @@ use nalgebra::Isometry3;
 use super::config::DynamicGaitConfig;
 use crate::controller::machine::STEP_HEIGHT_M;
 use crate::controller::sequence::{PreparedStance, Refusal};
+use crate::controller::status::PhaseTiming;
 
 /// The feet, in the order of the `[_; 2]` arrays of this module (left, right).
 pub(crate) const FEET: [EndEffector; 2] = [EndEffector::LeftFoot, EndEffector::RightFoot];
@@ -59,6 +69,8 @@ pub(crate) struct SupportPhase {
     pub duration_s: f64,
     /// Planned sole poses of the feet on the ground (left, right; `None` in the air).
     pub feet: [Option<Isometry3<f64>>; 2],
+    /// Where `duration_s` came from: the config or the sequence's stance durations.
+    pub timing: PhaseTiming,
 }
 
 impl SupportPhase {
@@ -97,6 +109,30 @@ struct Builder<'a> {
     /// The swing under way: its foot, the highest swing pose so far and its lift-off height.
     swing: Option<(EndEffector, Isometry3<f64>, f64)>,
     stepped: bool,
+    /// The sequence's time in the current support since its previous phase.
+    dwell: Dwell,
+}
+
+/// How long the sequence stays in the stances of a span, as far as it says.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Dwell {
+    /// No stance in the span.
+    Empty,
+    /// Every stance of the span is timed: their summed durations (s).
+    Timed(f64),
+    /// A stance of the span is untimed.
+    Untimed,
+}
+
+impl Dwell {
+    /// The span with one more stance, of duration `duration_s`.
+    fn and(self, duration_s: Option<f64>) -> Self {
+        match (self, duration_s) {
+            (Self::Untimed, _) | (_, None) => Self::Untimed,
+            (Self::Empty, Some(duration)) => Self::Timed(duration),
+            (Self::Timed(sum), Some(duration)) => Self::Timed(sum + duration),
+        }
+    }
 }
 
 impl FootstepPlan {
@@ -117,6 +153,7 @@ impl FootstepPlan {
             feet: standing.map(Some),
             swing: None,
             stepped: false,
+            dwell: Dwell::Empty,
         };
         let mut hands = [false; 2];
         for (i, stance) in stances.iter().enumerate() {
@@ -143,7 +180,10 @@ impl FootstepPlan {
             )));
         }
         let last = builder.plan.phases.len();
-        builder.double_support(timing.final_double_support_s, None);
+        builder.double_support(
+            (timing.final_double_support_s, PhaseTiming::Configured),
+            None,
+        );
         match builder.plan.transitions.last_mut() {
             Some(transition) if transition.stance == stances.len() - 1 => {
                 transition.phases.end = last + 1;
@@ -179,6 +219,7 @@ impl FootstepPlan {
                     start_s: phase.end_s(),
                     duration_s,
                     feet,
+                    timing: PhaseTiming::Configured,
                 };
                 self.phases.push(last);
                 last
@@ -187,6 +228,7 @@ impl FootstepPlan {
                 let last = SupportPhase {
                     support: Support::Double { lift_off: None },
                     duration_s: now_s + duration_s - phase.start_s,
+                    timing: PhaseTiming::Configured,
                     ..phase
                 };
                 self.phases[current] = last;
@@ -226,11 +268,7 @@ impl Builder<'_> {
         }
         for f in 0..2 {
             if released[f] {
-                let duration = if self.stepped {
-                    self.timing.double_support_s
-                } else {
-                    self.timing.initial_double_support_s
-                };
+                let duration = self.lift_off_double_support();
                 self.double_support(duration, Some(FEET[f]));
                 let lift_off_z = self.feet[f].map_or(0.0, |foot| foot.translation.z);
                 self.feet[f] = None;
@@ -239,7 +277,45 @@ impl Builder<'_> {
         }
         let feet_change = added.iter().chain(&released).any(|c| *c);
         if hands_change && !feet_change && self.swing.is_none() {
-            self.double_support(self.timing.hand_transition_s, None);
+            // The configured reach stands for the stances before it.
+            self.dwell = Dwell::Empty;
+            self.double_support(
+                (self.timing.hand_transition_s, PhaseTiming::Configured),
+                None,
+            );
+        }
+        self.dwell = self.dwell.and(stance.duration_s);
+    }
+
+    /// The double support that ends with a lift-off: the stances on both feet since the
+    /// support's previous phase, if all timed, else `double_support_s`; the first lift-off from
+    /// standing no shorter than `initial_double_support_s` (the CoM starts from rest).
+    fn lift_off_double_support(&mut self) -> (f64, PhaseTiming) {
+        let limits = self.timing.timed_double_support();
+        let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
+        if self.stepped {
+            timed(dwell, self.timing.double_support_s, limits, 0.0)
+        } else {
+            let initial = self.timing.initial_double_support_s;
+            timed(dwell, initial, limits, initial)
+        }
+    }
+
+    /// The single support of a swing from `lift_off_z` to `landing`: the stances its foot was in
+    /// the air, if all timed, else `single_support_s`; a step up or down no shorter than
+    /// `step_single_support()`.
+    fn swing_single_support(
+        &mut self,
+        lift_off_z: f64,
+        landing: &Isometry3<f64>,
+    ) -> (f64, PhaseTiming) {
+        let limits = self.timing.timed_single_support();
+        let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
+        if (landing.translation.z - lift_off_z).abs() > STEP_HEIGHT_M {
+            let step = self.timing.step_single_support();
+            timed(dwell, step, limits, step)
+        } else {
+            timed(dwell, self.timing.single_support_s, limits, 0.0)
         }
     }
 
@@ -250,11 +326,7 @@ impl Builder<'_> {
             .take()
             .expect("a foot is added only while it is in the air");
         debug_assert_eq!(swinging, foot);
-        let duration = if (landing.translation.z - lift_off_z).abs() > STEP_HEIGHT_M {
-            self.timing.step_single_support()
-        } else {
-            self.timing.single_support_s
-        };
+        let duration = self.swing_single_support(lift_off_z, &landing);
         self.push(
             Support::Single(SwingPlan {
                 foot,
@@ -267,18 +339,34 @@ impl Builder<'_> {
         self.stepped = true;
     }
 
-    fn double_support(&mut self, duration: f64, lift_off: Option<EndEffector>) {
+    fn double_support(&mut self, duration: (f64, PhaseTiming), lift_off: Option<EndEffector>) {
         self.push(Support::Double { lift_off }, duration);
     }
 
-    fn push(&mut self, support: Support, duration_s: f64) {
+    fn push(&mut self, support: Support, (duration_s, timing): (f64, PhaseTiming)) {
         self.plan.phases.push(SupportPhase {
             support,
             start_s: self.clock,
             duration_s,
             feet: self.feet,
+            timing,
         });
         self.clock += duration_s;
+    }
+}
+
+/// A phase's duration and its source: `configured` unless every stance of its span is timed
+/// (`dwell`); then their sum clamped into `[min, max]` and raised to `floor` (0: none), marked
+/// [`PhaseTiming::Clamped`] when that changed it.
+fn timed(dwell: Dwell, configured: f64, [min, max]: [f64; 2], floor: f64) -> (f64, PhaseTiming) {
+    let Dwell::Timed(sum) = dwell else {
+        return (configured, PhaseTiming::Configured);
+    };
+    let planned = sum.clamp(min, max).max(floor);
+    if planned == sum {
+        (planned, PhaseTiming::Sequence)
+    } else {
+        (planned, PhaseTiming::Clamped)
     }
 }
 
@@ -313,6 +401,7 @@ mod tests {
             posture: DVector::zeros(1),
             contacts,
             targets,
+            duration_s: None,
         }
     }
 
@@ -451,6 +540,229 @@ mod tests {
         assert_eq!(kinds(&plan), ["ds", "ds", "ds"]);
         assert_eq!(plan.phases[0].duration_s, timing.hand_transition_s);
         assert_eq!(plan.transitions[1].phases, 1..3);
+    }
+
+    /// `stance` as a timed stance of `duration_s`.
+    fn lasting(duration_s: f64, mut stance: PreparedStance) -> PreparedStance {
+        stance.duration_s = Some(duration_s);
+        stance
+    }
+
+    fn timings(plan: &FootstepPlan) -> Vec<(f64, PhaseTiming)> {
+        plan.phases
+            .iter()
+            .map(|p| (p.duration_s, p.timing))
+            .collect()
+    }
+
+    /// Two steps, the first swing spanning two stances (durations exact in binary).
+    fn timed_walk() -> Vec<PreparedStance> {
+        vec![
+            lasting(1.5, stance(DS, standing()[0], standing()[1])),
+            lasting(0.25, stance(LEFT_UP, at(0.05, 0.1, 0.04), standing()[1])),
+            lasting(0.5, stance(LEFT_UP, at(0.1, 0.1, 0.06), standing()[1])),
+            lasting(0.125, stance(DS, at(0.2, 0.1, 0.0), standing()[1])),
+            lasting(0.25, stance(DS, at(0.2, 0.1, 0.0), standing()[1])),
+            lasting(
+                0.875,
+                stance(RIGHT_UP, at(0.2, 0.1, 0.0), at(0.2, -0.1, 0.06)),
+            ),
+            lasting(5.0, stance(DS, at(0.2, 0.1, 0.0), at(0.4, -0.1, 0.0))),
+        ]
+    }
+
+    #[test]
+    fn a_timed_sequence_sets_its_supports_to_the_stances_sums() {
+        let timing = DynamicGaitConfig {
+            timed_single_support_s: Some([0.3, 2.0]),
+            timed_double_support_s: Some([0.1, 2.0]),
+            ..DynamicGaitConfig::default()
+        };
+        let plan = FootstepPlan::new(&timed_walk(), standing(), &timing).unwrap();
+        assert_eq!(kinds(&plan), ["ds+lift", "ss", "ds+lift", "ss", "ds"]);
+        use PhaseTiming::{Configured, Sequence};
+        assert_eq!(
+            timings(&plan),
+            [
+                // Standing 1.5 s (above initial_double_support_s, 1.0 s).
+                (1.5, Sequence),
+                // The left swing through two stances: 0.25 + 0.5 s.
+                (0.75, Sequence),
+                // Both feet down in two stances: 0.125 + 0.25 s.
+                (0.375, Sequence),
+                (0.875, Sequence),
+                (timing.final_double_support_s, Configured),
+            ]
+        );
+        for pair in plan.phases.windows(2) {
+            assert_eq!(pair[0].end_s(), pair[1].start_s);
+        }
+    }
+
+    #[test]
+    fn timed_durations_outside_the_limits_are_clamped() {
+        // Default limits: single support [0.55, 1.65] s, double support [0.25, 1.0] s.
+        let timing = DynamicGaitConfig::default();
+        let stances = [
+            lasting(0.5, stance(DS, standing()[0], standing()[1])),
+            lasting(0.125, stance(LEFT_UP, at(0.1, 0.1, 0.05), standing()[1])),
+            lasting(9.0, stance(DS, at(0.2, 0.1, 0.0), standing()[1])),
+            lasting(
+                0.75,
+                stance(RIGHT_UP, at(0.2, 0.1, 0.0), at(0.2, -0.1, 0.06)),
+            ),
+            lasting(0.5, stance(DS, at(0.2, 0.1, 0.0), at(0.4, -0.1, 0.0))),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        use PhaseTiming::{Clamped, Configured, Sequence};
+        assert_eq!(
+            timings(&plan),
+            [
+                // The first lift-off: no shorter than initial_double_support_s.
+                (timing.initial_double_support_s, Clamped),
+                (timing.single_support_s, Clamped),
+                (4.0 * timing.double_support_s, Clamped),
+                (0.75, Sequence),
+                (timing.final_double_support_s, Configured),
+            ]
+        );
+    }
+
+    #[test]
+    fn a_timed_step_up_is_no_shorter_than_the_step_single_support() {
+        let timing = DynamicGaitConfig::default();
+        let step = |duration_s| {
+            let stances = [
+                lasting(1.0, stance(DS, standing()[0], standing()[1])),
+                lasting(
+                    duration_s,
+                    stance(LEFT_UP, at(0.15, 0.1, 0.13), standing()[1]),
+                ),
+                lasting(1.0, stance(DS, at(0.3, 0.1, 0.1), standing()[1])),
+            ];
+            let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+            (plan.phases[1].duration_s, plan.phases[1].timing)
+        };
+        assert_eq!(
+            step(0.75),
+            (timing.step_single_support(), PhaseTiming::Clamped)
+        );
+        assert_eq!(step(1.5), (1.5, PhaseTiming::Sequence));
+    }
+
+    #[test]
+    fn an_untimed_sequence_gives_the_configured_plan() {
+        let timing = DynamicGaitConfig::default();
+        let untimed: Vec<PreparedStance> = timed_walk()
+            .into_iter()
+            .map(|stance| PreparedStance {
+                duration_s: None,
+                ..stance
+            })
+            .collect();
+        let plan = FootstepPlan::new(&untimed, standing(), &timing).unwrap();
+        let configured = [
+            timing.initial_double_support_s,
+            timing.single_support_s,
+            timing.double_support_s,
+            timing.single_support_s,
+            timing.final_double_support_s,
+        ];
+        assert_eq!(
+            timings(&plan),
+            configured.map(|duration| (duration, PhaseTiming::Configured))
+        );
+    }
+
+    #[test]
+    fn a_partly_timed_span_falls_back_to_the_config() {
+        let timing = DynamicGaitConfig::default();
+        let mut stances = timed_walk();
+        // The second stance of the left swing, and the first of the double support after it.
+        stances[2].duration_s = None;
+        stances[3].duration_s = None;
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        use PhaseTiming::{Clamped, Configured, Sequence};
+        assert_eq!(
+            timings(&plan),
+            [
+                (timing.initial_double_support_s, Clamped),
+                (timing.single_support_s, Configured),
+                (timing.double_support_s, Configured),
+                (0.875, Sequence),
+                (timing.final_double_support_s, Configured),
+            ]
+        );
+    }
+
+    #[test]
+    fn hand_reaches_and_a_change_of_support_foot_keep_their_configured_durations() {
+        let timing = DynamicGaitConfig::default();
+        let mut with_hand = DS;
+        with_hand[LH] = true;
+        let stances = [
+            lasting(0.75, stance(RIGHT_UP, standing()[0], at(0.1, -0.1, 0.05))),
+            lasting(
+                0.75,
+                stance(LEFT_UP, at(0.0, 0.1, 0.05), at(0.2, -0.1, 0.0)),
+            ),
+            lasting(0.375, stance(DS, at(0.3, 0.1, 0.0), at(0.2, -0.1, 0.0))),
+            // The reach stands for the stance before it; the lift-off after it takes this one.
+            lasting(
+                0.5,
+                stance(with_hand, at(0.3, 0.1, 0.0), at(0.2, -0.1, 0.0)),
+            ),
+            lasting(
+                0.75,
+                stance(RIGHT_UP, at(0.3, 0.1, 0.0), at(0.3, -0.1, 0.05)),
+            ),
+            lasting(
+                0.5,
+                stance(with_hand, at(0.3, 0.1, 0.0), at(0.4, -0.1, 0.0)),
+            ),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        assert_eq!(
+            kinds(&plan),
+            [
+                "ds+lift", "ss", "ds+lift", "ss", "ds", "ds+lift", "ss", "ds"
+            ]
+        );
+        use PhaseTiming::{Configured, Sequence};
+        assert_eq!(
+            timings(&plan),
+            [
+                // Lifting off at once from standing: no stance on both feet.
+                (timing.initial_double_support_s, Configured),
+                (0.75, Sequence),
+                // Right lands and left lifts at once: no stance on both feet between.
+                (timing.double_support_s, Configured),
+                (0.75, Sequence),
+                (timing.hand_transition_s, Configured),
+                (0.5, Sequence),
+                (0.75, Sequence),
+                (timing.final_double_support_s, Configured),
+            ]
+        );
+    }
+
+    #[test]
+    fn a_controlled_stop_ends_with_the_configured_double_support() {
+        let mut plan =
+            FootstepPlan::new(&timed_walk(), standing(), &DynamicGaitConfig::default()).unwrap();
+        // During the first swing: it lands, then the stop's double support.
+        let last = plan.end_early(1, 0, 1.2, 0.6);
+        assert_eq!(
+            (last.duration_s, last.timing),
+            (0.6, PhaseTiming::Configured)
+        );
+        assert_eq!(plan.phases.last(), Some(&last));
+        // During a timed double support: it becomes the stop's.
+        let mut plan =
+            FootstepPlan::new(&timed_walk(), standing(), &DynamicGaitConfig::default()).unwrap();
+        let last = plan.end_early(0, 0, 0.5, 0.6);
+        assert_eq!(last.timing, PhaseTiming::Configured);
+        assert!((last.duration_s - 1.1).abs() < 1e-12);
     }
 
     #[test]

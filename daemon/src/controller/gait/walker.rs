@@ -51,7 +51,7 @@ use crate::controller::machine::{
 };
 use crate::controller::sequence::PreparedSequence;
 use crate::controller::sequencer::on_both_feet;
-use crate::controller::status::{BalanceStatus, FaultCode, Phase};
+use crate::controller::status::{BalanceStatus, FaultCode, Phase, PlannedPhase};
 use crate::controller::trajectory::{PoseTrajectory, Profile};
 
 /// How far above its foothold's height a swing sole may be and still count as landed when no
@@ -658,6 +658,10 @@ impl DynamicWalker {
             dcm_reference: xy(reference.dcm),
             dcm_measured: xy(dcm + offset),
             com_offset: xy(offset),
+            planned_phase: self.current_phase().map(|phase| PlannedPhase {
+                duration_s: phase.duration_s,
+                timing: phase.timing,
+            }),
         };
     }
 
