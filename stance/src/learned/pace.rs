@@ -6,9 +6,10 @@
 //! walk after post-processing) the model's gait law ([`super::gait_law`]) gives, at the robot's
 //! dimensionless speed V / √(g L) (L its standing pelvis height, the leg length the law uses),
 //! the single- and double-support times of a person walking that way. The generated walk's
-//! supports are retimed so that their medians are those times, and the walk is stretched along
-//! the path so that its length over its time is V once post-processing has shortened every step
-//! by `scf`. Its steps are then as long as the speed needs at the law's timing (they include the
+//! supports are retimed so that their medians are those times, each stance kept within the
+//! robot's timing limits (walkd's, which would otherwise change it), and the walk is stretched
+//! along the path so that its length over its time is V once post-processing has shortened every
+//! step by `scf`. Its steps are then as long as the speed needs at that timing (they include the
 //! walk's stances that are not steps), not the law's own step length, which is reported beside.
 
 use kinematics::ground::GRAVITY;
@@ -23,7 +24,7 @@ use crate::walk::WalkingSpeed;
 /// A walking speed asked of a learned walk, and the post-processing it is planned for.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpeedRequest {
-    /// The speed and the robot's shortest supports.
+    /// The speed and the robot's timing limits.
     pub speed: WalkingSpeed,
     /// The post-processing's sequence scaling factor, which shortens every step by it.
     pub scf: f64,
