@@ -423,7 +423,8 @@ fn version_1_model_files_load_without_a_gait_law() {
 /// A walk paced for a speed: every stance is timed, within the robot's timing limits, and the
 /// post-processed walk covers the distance at the speed (its length over the summed durations
 /// of the stances between the first and the last, which the gait times with its own standing
-/// phases); a slower request takes shorter steps and longer stances.
+/// phases), starting and stopping with shorter steps; a slower request takes shorter steps and
+/// longer stances.
 #[test]
 fn a_paced_walk_is_timed_for_its_speed_within_the_robots_limits() {
     use kinematics::ConfigFile;
@@ -473,6 +474,34 @@ fn a_paced_walk_is_timed_for_its_speed_within_the_robots_limits() {
                 + t[EndEffector::RightFoot as usize].translation.vector)
                 / 2.0
         };
+        // It starts and stops with shorter steps: the first and the last swing of the walk
+        // travel less than four fifths of its median swing.
+        let mut swings = Vec::new();
+        for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
+            let at = |i: usize| walk.targets(i)[foot as usize].translation.vector;
+            let mut lifted_at = None;
+            for i in 1..walk.len() {
+                let (before, now) = (
+                    walk.contacts(i - 1)[foot as usize],
+                    walk.contacts(i)[foot as usize],
+                );
+                if before && !now {
+                    lifted_at = Some(at(i - 1));
+                } else if !before && now {
+                    let from = lifted_at.take().expect("a swing lifts off first");
+                    swings.push((i, (at(i) - from).xy().norm()));
+                }
+            }
+        }
+        swings.sort_by_key(|(i, _)| *i);
+        let mut travels: Vec<f64> = swings.iter().map(|(_, d)| *d).collect();
+        let (first, last) = (travels[0], travels[travels.len() - 1]);
+        travels.sort_by(f64::total_cmp);
+        let median = travels[travels.len() / 2];
+        assert!(
+            first < 0.8 * median && last < 0.8 * median,
+            "{speed} m/s: swings {first:.3}, median {median:.3}, last {last:.3} m"
+        );
         let length = (feet(walk.len() - 1) - feet(0)).xy().norm();
         assert!((length / 5.0 - 1.0).abs() < 0.1, "{speed} m/s: {length} m");
         let planned = length / time;

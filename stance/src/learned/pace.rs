@@ -94,12 +94,20 @@ impl RobotGait {
     }
 }
 
+/// Over how many of its median steps a paced walk gets up to its stride, and comes to rest: a
+/// person starting from standing takes a shorter first step and lengthens the next.
+pub(crate) const RAMP_STEPS: f64 = 2.0;
+
 /// How a token sequence is laid out and timed for the robot.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Pace {
     /// Factor on the human path's forward lengths (root progress and the effectors' forward
     /// offsets).
     pub stretch: f64,
+    /// Human path metres at the start and at the end over which the stretch grows from half and
+    /// shrinks to half ([`PathStretch`]): [`RAMP_STEPS`] median steps of a paced walk, none
+    /// otherwise.
+    pub ramp: f64,
     /// Factors from a token's human duration to the robot stance's: single, double support.
     time: [f64; 2],
     /// The limits `[min, max]` of a robot stance of each kind (s): single, double support.
@@ -111,6 +119,7 @@ impl Pace {
     pub fn similar(scale: f64) -> Self {
         Self {
             stretch: 1.0,
+            ramp: 0.0,
             time: [scale.sqrt(); 2],
             limits: [[0.0, f64::INFINITY]; 2],
         }
@@ -119,9 +128,10 @@ impl Pace {
     /// The pace that walks `generated` (laid out at `scale`, post-processed with
     /// `request.scf`) at `request.speed` with `gait`'s single and double supports: the supports
     /// are retimed so that their medians over the walk's complete steps are the gait's (each
-    /// stance within the robot's limits for its kind), then the path is stretched
-    /// so that the walk's length over its stances' total time (first and last stance left out:
-    /// the gait starts and ends with its own standing phases) is the speed.
+    /// stance within the robot's limits for its kind), then the path is stretched, with a
+    /// ramp of [`RAMP_STEPS`] median steps at each end, so that the walk's length over its stances' total
+    /// time (first and last stance left out: the gait starts and ends with its own standing
+    /// phases) is the speed.
     pub fn for_speed(
         model: &NgramModel,
         generated: &Generated,
@@ -135,7 +145,12 @@ impl Pace {
             measured.double_support.si.p50,
         ];
         let human_length = generated.progress.last().copied().unwrap_or(0.0);
-        if medians.iter().any(|m| !(m.is_finite() && *m > 0.0)) || human_length <= 0.0 {
+        let step = measured.step_length.si.p50;
+        let known = medians
+            .iter()
+            .chain([&step])
+            .all(|m| m.is_finite() && *m > 0.0);
+        if !known || human_length <= 0.0 {
             return Err(LearnError::Query(
                 "the generated walk has no complete step to set its pace by: ask for a longer \
                  distance"
@@ -146,6 +161,7 @@ impl Pace {
         let within = |duration: f64, [min, max]: [f64; 2]| duration.clamp(min, max);
         let mut pace = Self {
             stretch: 1.0,
+            ramp: RAMP_STEPS * step,
             time: [
                 within(gait.single_support, limits[0]) / medians[0],
                 within(gait.double_support, limits[1]) / medians[1],
@@ -158,7 +174,8 @@ impl Pace {
             .iter()
             .map(|&id| pace.duration(model.token(id)))
             .sum();
-        pace.stretch = request.speed.m_s * time / (human_length * scale * request.scf);
+        let length = PathStretch::new(1.0, pace.ramp, human_length).covered();
+        pace.stretch = request.speed.m_s * time / (length * scale * request.scf);
         Ok(pace)
     }
 
@@ -181,6 +198,64 @@ impl Pace {
     }
 }
 
+/// The map from the human path's along-path coordinate to the robot's (before the size scale):
+/// lengths × `factor`, but over the first and the last `ramp` metres the factor grows linearly
+/// from half of it and shrinks back to half, so that the walk starts and stops with shorter
+/// steps, as people do (before the start and after the end: half of it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PathStretch {
+    factor: f64,
+    ramp: f64,
+    end: f64,
+}
+
+impl PathStretch {
+    /// The identity.
+    pub const NONE: Self = Self {
+        factor: 1.0,
+        ramp: 0.0,
+        end: 0.0,
+    };
+
+    /// `factor` over a path of `end` human metres, with ramps of `ramp` metres (at most half
+    /// the path each).
+    pub fn new(factor: f64, ramp: f64, end: f64) -> Self {
+        Self {
+            factor,
+            ramp: ramp.clamp(0.0, end.max(0.0) / 2.0),
+            end,
+        }
+    }
+
+    /// The robot's along-path coordinate of human coordinate `x`: the factor integrated from 0.
+    pub fn map(&self, x: f64) -> f64 {
+        let (k, r, d) = (self.factor, self.ramp, self.end);
+        if r <= 0.0 {
+            return k * x;
+        }
+        // Through a ramp of length r the factor goes from k/2 to k: its integral over the first
+        // u metres is k (u/2 + u²/(4r)), 3kr/4 over the whole ramp.
+        let ramp = |u: f64| k * (u / 2.0 + u * u / (4.0 * r));
+        let covered = k * (d - r / 2.0);
+        if x <= 0.0 {
+            k * x / 2.0
+        } else if x <= r {
+            ramp(x)
+        } else if x <= d - r {
+            ramp(r) + k * (x - r)
+        } else if x <= d {
+            covered - ramp(d - x)
+        } else {
+            covered + k * (x - d) / 2.0
+        }
+    }
+
+    /// The robot length of the human path from 0 to its end.
+    pub fn covered(&self) -> f64 {
+        self.map(self.end) - self.map(0.0)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -195,6 +270,30 @@ mod tests {
             translation: [0.3, 0.0, 0.0],
             effectors: [None; 4],
         }
+    }
+
+    #[test]
+    fn a_path_stretch_starts_and_ends_at_half_its_factor_and_is_continuous() {
+        let path = PathStretch::new(2.0, 1.0, 10.0);
+        // Half the factor at the ends, the whole factor between the ramps.
+        let slope = |x: f64| (path.map(x + 1e-6) - path.map(x - 1e-6)) / 2e-6;
+        for (x, expected) in [(0.0, 1.0), (0.5, 1.5), (5.0, 2.0), (9.5, 1.5), (10.0, 1.0)] {
+            assert!(
+                (slope(x) - expected).abs() < 1e-5,
+                "slope at {x}: {}",
+                slope(x)
+            );
+        }
+        assert!((path.map(1.0) - 1.5).abs() < 1e-12);
+        assert!((path.covered() - 2.0 * 9.5).abs() < 1e-12);
+        // A first step of one ramp is three quarters of a middle step of the same human length.
+        let first = path.map(1.0) - path.map(0.0);
+        let middle = path.map(5.0) - path.map(4.0);
+        assert!((first / middle - 0.75).abs() < 1e-12);
+        // Without a ramp, a plain factor; a ramp longer than half the path is cut to it.
+        assert_eq!(PathStretch::new(2.0, 0.0, 10.0).map(3.0), 6.0);
+        assert!((PathStretch::new(1.0, 8.0, 4.0).covered() - 3.0).abs() < 1e-12);
+        assert_eq!(PathStretch::NONE.map(3.0), 3.0);
     }
 
     #[test]

@@ -10,7 +10,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use super::error::LearnError;
 use super::model::NgramModel;
-use super::pace::{Pace, RobotGait, SpeedRequest};
+use super::pace::{Pace, PathStretch, RobotGait, SpeedRequest};
 use super::query::{Generated, Query, Search, generate_tokens};
 use crate::environment::{Environment, HandAffordance};
 use crate::generate::AffordanceSet;
@@ -48,8 +48,8 @@ struct RobotFrame {
     scale: f64,
     /// The robot's leg length: its standing pelvis height above the soles (m).
     leg_length: f64,
-    /// Factor on the human path's forward lengths ([`Pace::stretch`]).
-    stretch: f64,
+    /// The human path's forward lengths on the robot's ([`PathStretch`]).
+    path: PathStretch,
     /// Unit walking direction (horizontal).
     forward: Vector3<f64>,
     /// Standing hand orientations in the world.
@@ -62,7 +62,7 @@ impl RobotFrame {
         Self {
             scale: standing.pelvis_height / human_pelvis_height,
             leg_length: standing.pelvis_height,
-            stretch: 1.0,
+            path: PathStretch::NONE,
             forward: standing.forward,
             hand_rotations: [
                 standing.pose(EndEffector::LeftHand).rotation,
@@ -79,7 +79,7 @@ impl RobotFrame {
     /// along the path).
     fn point(&self, human: Vector3<f64>) -> Vector3<f64> {
         let lateral = Vector3::z().cross(&self.forward);
-        (self.forward * human.x * self.stretch + lateral * human.y + Vector3::z() * human.z)
+        (self.forward * self.path.map(human.x) + lateral * human.y + Vector3::z() * human.z)
             * self.scale
     }
 }
@@ -180,9 +180,10 @@ pub fn generate_learned(
 ) -> Result<Retargeted, LearnError> {
     let mut frame = RobotFrame::measure(robot, model.human_pelvis_height);
     let railing = options.railing.unwrap_or([0.0, options.distance]);
-    // Human path metres before the stretch: the stretched walk covers the distance.
-    let query = |stretch: f64| Query {
-        distance: options.distance / frame.scale / stretch,
+    // Human path metres before the stretch (and its ramps): the stretched walk covers the
+    // distance.
+    let query = |stretch: f64, ramp: f64| Query {
+        distance: options.distance / frame.scale / stretch + ramp / 2.0,
         hands: hand_intervals(
             options.affordances,
             railing.map(|s| s / frame.scale / stretch),
@@ -191,7 +192,7 @@ pub fn generate_learned(
     };
     let (generated, pace, gait) = match options.speed {
         None => (
-            generate_tokens(model, &query(1.0))?,
+            generate_tokens(model, &query(1.0, 0.0))?,
             Pace::similar(frame.scale),
             None,
         ),
@@ -201,13 +202,14 @@ pub fn generate_learned(
             // is asked for, which the stretch sets: a few rounds bring them together. The walk
             // is laid out at the stretch it was generated for (so it covers the distance), its
             // times corrected by what is left between the two (so it walks at the speed).
-            let mut stretch = 1.0;
+            let (mut stretch, mut ramp) = (1.0, 0.0);
             let mut walk = None;
             for _ in 0..PACE_ROUNDS {
-                let generated = generate_tokens(model, &query(stretch))?;
+                let generated = generate_tokens(model, &query(stretch, ramp))?;
                 let pace = Pace::for_speed(model, &generated, &gait, request, frame.scale)?;
                 let settled = (pace.stretch / stretch - 1.0).abs() < PACE_TOLERANCE;
                 let next = pace.stretch;
+                ramp = pace.ramp;
                 walk = Some((generated, pace.at_stretch(stretch)));
                 if settled {
                     break;
@@ -218,7 +220,8 @@ pub fn generate_learned(
             (generated, pace, Some(gait))
         }
     };
-    frame.stretch = pace.stretch;
+    let end = generated.progress.last().copied().unwrap_or(0.0);
+    frame.path = PathStretch::new(pace.stretch, pace.ramp, end);
     let layout = lay_out(model, &generated, &frame, &pace);
     let (stances, ik_errors) = solve(robot, &layout)?;
     let environment = environment(&layout, options, &frame);
