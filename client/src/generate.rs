@@ -68,7 +68,7 @@ fn parse_interval(text: &str) -> Result<[f64; 2], String> {
 
 /// Runs `walkctl generate`.
 pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
-    // The gait only picks the limits here (`scf`, and with --speed the shortest supports), but
+    // The gait only picks the limits here (`scf`, and with --speed the timing limits), but
     // a walk the robot cannot make is refused now, before anything is written, rather than by
     // walkd.
     let file = ConfigFile::load(&args.robot)?;
