@@ -54,7 +54,7 @@ use shm_types::process::Physics;
 use shm_types::{ClockMode, DaemonState, SimTruth};
 use stance::learned::{SourceArgs, StanceSource};
 use stance::poses::FEET;
-use stance::{AffordanceSet, Gait, PostProcessedSequence, Scene, WalkRequest};
+use stance::{AffordanceSet, Gait, PostProcessedSequence, Scene, WalkRequest, WalkingSpeed};
 
 use crate::args::SPEED_M_S;
 use crate::daemon_client::connect_when_fresh;
@@ -329,16 +329,20 @@ struct Subject<'a> {
     model: Arc<Robot>,
     /// The gait its walks use (`--gait`, else its config's default).
     gait: Gait,
+    /// `--speed` within its timing limits, if asked.
+    speed: Option<WalkingSpeed>,
     /// The fault injections of each walk.
     injections: Vec<Option<Injection>>,
 }
 
 impl<'a> Subject<'a> {
-    /// Loads robot `robot` of the matrix; refuses it when it cannot walk the gait.
+    /// Loads robot `robot` of the matrix; refuses it when it cannot walk the gait (or, with
+    /// `--speed`, pace it).
     fn load(args: &EvaluateArgs, robot: &'a str) -> anyhow::Result<Self> {
         let config = args.config_dir.join(format!("{robot}.toml"));
         let file = ConfigFile::load(&config)?;
         let gait = Gait::for_walk(args.gait, &file)?;
+        let speed = walking_speed(args.speed, &file, gait)?;
         let model = Arc::new(
             Robot::from_config(&file, args.urdf.as_deref())
                 .with_context(|| format!("robot `{robot}` ({})", config.display()))?,
@@ -350,6 +354,7 @@ impl<'a> Subject<'a> {
             file,
             model,
             gait,
+            speed,
             injections,
         })
     }
@@ -465,12 +470,13 @@ fn run_once(
         file,
         model,
         gait,
+        speed,
         ..
     } = subject;
     let (robot, gait) = (*robot, *gait);
     let params = stance::PostProcessParams::from_config_for(file, gait)?;
     let request = &WalkRequest {
-        speed: walking_speed(args.speed, file, gait)?,
+        speed: *speed,
         ..*request
     };
     let &WalkRequest {

@@ -7,10 +7,9 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::builder::RangedU64ValueParser;
 use kinematics::bounds::Range;
-use stance::learned::gait_law::walker_table;
+use stance::learned::gait_law::{walker_table, walkers_of};
 use stance::learned::{
-    Demonstration, GaitLaw, NgramModel, TrainOptions, WalkerGait, load_folder, segment,
-    taxonomy_label,
+    Demonstration, GaitLaw, NgramModel, TrainOptions, load_folder, segment, taxonomy_label,
 };
 
 /// Arguments of `walkctl learn`.
@@ -105,12 +104,9 @@ fn load_folders(dirs: &[PathBuf]) -> anyhow::Result<Vec<Demonstration>> {
 /// the law stored in the model, or why the model has none.
 fn print_gait_law<'a>(model: &NgramModel, demos: impl Iterator<Item = &'a Demonstration>) {
     println!("gait law walkers (level ground, ≥ 3 complete steps; medians over the steps):");
-    let mut walkers = Vec::new();
-    for demo in demos {
-        match WalkerGait::measure(demo) {
-            Ok(walker) => walkers.push(walker),
-            Err(reason) => println!("{}: left out: {reason}", demo.name),
-        }
+    let (walkers, left_out) = walkers_of(demos);
+    for (name, reason) in &left_out {
+        println!("{name}: left out: {reason}");
     }
     print!("{}", walker_table(&walkers));
     match &model.gait_law {

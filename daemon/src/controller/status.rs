@@ -361,7 +361,7 @@ impl PhaseTiming {
 mod tests {
     use super::*;
 
-    /// The telemetry carries a timing as the wire code of its name (runtime/telemetry.rs).
+    /// The names are the telemetry's wire names (runtime/telemetry.rs checks each code's name).
     #[test]
     fn phase_timings_have_their_wire_names() {
         let timings = [

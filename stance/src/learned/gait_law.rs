@@ -304,6 +304,22 @@ impl fmt::Display for GaitLaw {
     }
 }
 
+/// The trials of `demos` that are walkers for the law ([`WalkerGait::measure`]), and each other
+/// trial's name with the reason it is left out: what training fits and `walkctl learn` reports.
+pub fn walkers_of<'a>(
+    demos: impl Iterator<Item = &'a Demonstration>,
+) -> (Vec<WalkerGait>, Vec<(String, String)>) {
+    let mut walkers = Vec::new();
+    let mut left_out = Vec::new();
+    for demo in demos {
+        match WalkerGait::measure(demo) {
+            Ok(walker) => walkers.push(walker),
+            Err(reason) => left_out.push((demo.name.clone(), reason)),
+        }
+    }
+    (walkers, left_out)
+}
+
 /// The walkers as a Markdown table (name, L, v, v̂, λ, τ, δ), as `walkctl learn` prints them.
 pub fn walker_table(walkers: &[WalkerGait]) -> String {
     let mut table = String::from(

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use super::cluster::cluster;
 use super::demo::Demonstration;
 use super::error::LearnError;
-use super::gait_law::{GaitLaw, WalkerGait};
+use super::gait_law::{GaitLaw, walkers_of};
 use super::hands::{HandSupport, count_hand_support};
 use super::segment::{Keyframe, RelativePose, SegmentOptions, segment};
 
@@ -327,8 +327,7 @@ impl NgramModel {
 /// The gait law of the demonstrations that are walkers on level ground (others left out), or
 /// `None` when it cannot be fitted (`walkctl learn` reports why).
 fn fit_gait_law<'a>(demos: impl Iterator<Item = &'a Demonstration>) -> Option<GaitLaw> {
-    let walkers: Vec<WalkerGait> = demos.filter_map(|d| WalkerGait::measure(d).ok()).collect();
-    GaitLaw::fit(&walkers).ok()
+    GaitLaw::fit(&walkers_of(demos).0).ok()
 }
 
 fn sum(entry: &ContextCounts) -> u32 {
