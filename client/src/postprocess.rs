@@ -45,6 +45,9 @@ pub struct ParamOverrides {
     /// Maximal swing-foot height [m].
     #[arg(long)]
     pub h_max: Option<f64>,
+    /// How much a step's rise or drop counts against s_max on terrain (>= 1).
+    #[arg(long)]
+    pub rise_weight: Option<f64>,
     /// Pass 2 variant: `first` (the paper's) or `mean`.
     #[arg(long, value_parser = parse_unification)]
     pub contact_unification: Option<ContactUnification>,
@@ -75,6 +78,7 @@ impl ParamOverrides {
             (self.alpha_z, &mut p.alpha_z),
             (self.h_min, &mut p.h_min),
             (self.h_max, &mut p.h_max),
+            (self.rise_weight, &mut p.rise_weight),
         ];
         for (value, field) in fields {
             if let Some(value) = value {

@@ -158,6 +158,12 @@ pub struct PostProcessParams {
     pub h_min: f64,
     /// Maximal swing-foot height above its surface `h_max`.
     pub h_max: f64,
+    /// How much a step's rise or drop `h` counts against `s_max` on terrain: a step of `d` along
+    /// the path is `√(d² + (rise_weight · h)²)` long. 1 (the default): the step in space. More:
+    /// shorter steps up and down, for knees that lift or lower the whole body over the step
+    /// (docs/scenes.md, "Step length up and down").
+    #[serde(default = "PostProcessParams::default_rise_weight")]
+    pub rise_weight: f64,
     /// Pass 2 variant; `first` unless the config says `contact_unification = "mean"`.
     #[serde(default)]
     pub contact_unification: ContactUnification,
@@ -215,6 +221,11 @@ pub enum ParamsError {
 const DYNAMIC_OVERRIDES: &str = "dynamic";
 
 impl PostProcessParams {
+    /// `rise_weight` unless configured: a step's limit is on its length in space.
+    fn default_rise_weight() -> f64 {
+        1.0
+    }
+
     /// Reads the `[postprocess]` section of the robot config at `path` (the static gait's).
     pub fn from_config_path(path: &Path) -> Result<Self, ParamsError> {
         Self::from_config(&ConfigFile::load(path)?)
@@ -323,6 +334,7 @@ impl PostProcessParams {
             Bound::new("alpha_z", self.alpha_z, 0.0, 1.5),
             Bound::new("h_min", self.h_min, 0.0, 0.5),
             Bound::new("h_max", self.h_max, 0.0, 0.5),
+            Bound::new("rise_weight", self.rise_weight, 1.0, 10.0),
         ]
     }
 
@@ -479,5 +491,21 @@ mod tests {
         let text = SECTION.replace("scf = 0.4", "scf = 1.5");
         let err = PostProcessParams::from_config_str(&text, Path::new("r.toml")).unwrap_err();
         assert!(err.to_string().contains("`scf`"), "{err}");
+    }
+
+    #[test]
+    fn the_rise_weight_defaults_to_the_step_in_space_and_is_checked() {
+        let path = Path::new("r.toml");
+        let params = PostProcessParams::from_config_str(SECTION, path).unwrap();
+        assert_eq!(params.rise_weight, 1.0);
+        let text = format!("{SECTION}\n[postprocess.dynamic]\nrise_weight = 3.5\n");
+        let file = ConfigFile::parse(&text, path).unwrap();
+        let dynamic = PostProcessParams::from_config_for(&file, Gait::Dynamic).unwrap();
+        assert_eq!(dynamic.rise_weight, 3.5);
+        for bad in ["0.5", "nan", "11"] {
+            let text = format!("{SECTION}\nrise_weight = {bad}\n");
+            let err = PostProcessParams::from_config_str(&text, path).unwrap_err();
+            assert!(err.to_string().contains("`rise_weight`"), "{bad}: {err}");
+        }
     }
 }

@@ -54,7 +54,10 @@ fn walk_in(
 ) -> (PostProcessedSequence, Environment) {
     let (robot, mut params) = jvrc1(gait);
     if let Some(s_max) = s_max {
+        // A step limit of the test's own, on the step in space (JVRC-1's dynamic config
+        // weights a rise 3.5 times, which is not what these tests are about).
         params.s_max = s_max;
+        params.rise_weight = 1.0;
     }
     let environment = scene.walk_environment();
     let request = WalkRequest {

@@ -361,6 +361,11 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
     } else {
         dynamic.push(key("alpha_y", reference::dynamic::ALPHA_Y, "JVRC-1's"));
     }
+    dynamic.push(key(
+        "rise_weight",
+        reference::dynamic::RISE_WEIGHT,
+        "JVRC-1's: shorter steps up and down stairs",
+    ));
 
     let controller = controller(r, t, max_step, s_max_dynamic);
 

@@ -83,7 +83,7 @@ pub const CONTROLLER: [(&str, Tuned); 40] = [
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic]`, in its order.
-pub const GAIT_DYNAMIC: [(&str, Tuned); 13] = [
+pub const GAIT_DYNAMIC: [(&str, Tuned); 14] = [
     ("single_support_s", Tuned::Number(0.55)),
     ("double_support_s", Tuned::Number(0.25)),
     ("initial_double_support_s", Tuned::Number(1.0)),
@@ -96,6 +96,7 @@ pub const GAIT_DYNAMIC: [(&str, Tuned); 13] = [
     ("late_descent_speed", Tuned::Number(0.05)),
     ("late_lift_off_max_s", Tuned::Number(0.2)),
     ("hand_weight", Tuned::Number(0.02)),
+    ("com_gain", Tuned::Number(3.0)),
     ("torso_posture_weight", Tuned::Number(1.0)),
 ];
 
@@ -144,6 +145,8 @@ pub mod dynamic {
     pub const H: (f64, f64) = (0.02, 0.03);
     /// `alpha_y` (rad).
     pub const ALPHA_Y: f64 = 0.05;
+    /// `rise_weight`.
+    pub const RISE_WEIGHT: f64 = 3.5;
 }
 
 /// The value of `key` in one of the tables above.

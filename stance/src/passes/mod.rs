@@ -194,7 +194,7 @@ pub fn run_passes_observed(
     after(Pass::LimitToMaxStepSize, poses);
     limit_orthogonal_feet_distance(poses, &path, params.o_min, params.o_max);
     after(Pass::LimitOrthogonalFeetDistance, poses);
-    place_on_terrain(poses, environment, sole, params.s_max);
+    place_on_terrain(poses, environment, sole, params.s_max, params.rise_weight);
     after(Pass::PlaceOnTerrain, poses);
     hold_hand_affordances(poses, environment, contact.palm_radius);
     after(Pass::HoldHandAffordances, poses);
@@ -301,6 +301,7 @@ mod tests {
             alpha_z: 0.1,
             h_min: 0.03,
             h_max: 0.1,
+            rise_weight: 1.0,
             contact_unification: ContactUnification::First,
             gait: crate::Gait::Static,
         }

@@ -83,6 +83,7 @@ pub fn place_on_terrain(
     environment: &Environment,
     sole: &SoleRectangle,
     s_max: f64,
+    rise_weight: f64,
 ) {
     if environment.is_flat_ground() {
         return;
@@ -97,6 +98,7 @@ pub fn place_on_terrain(
             path,
             sole,
             s_max,
+            rise_weight,
             surface: [None; 2],
             along: [None; 2],
         },
@@ -145,6 +147,8 @@ struct Footholds<'a> {
     sole: &'a SoleRectangle,
     /// The step limit (pass 7's `s_max`): one foot per stair only where its steps keep to it.
     s_max: f64,
+    /// How much a step's rise or drop counts against `s_max` (`[postprocess] rise_weight`).
+    rise_weight: f64,
     /// Index of the surface each foot last landed on.
     surface: [Option<usize>; 2],
     /// Along-path position of each foot's last landing.
@@ -237,9 +241,11 @@ impl Footholds<'_> {
     }
 
     /// The farthest along-path landing of foot `f` on surface `k` (on the line `lateral`) that
-    /// keeps its step within `s_max`. The limit is on the step in space, as the controller's
-    /// `max_step_m` measures it: a step that also rises or falls by `h` reaches
-    /// `√(s_max² − h²)` along the path (a 0.48 m limit, 0.456 m down a 0.15 m stair).
+    /// keeps its step within `s_max`. With `rise_weight` 1 the limit is on the step in space, as
+    /// the controller's `max_step_m` measures it: a step that also rises or falls by `h` reaches
+    /// `√(s_max² − h²)` along the path (a 0.48 m limit, 0.456 m down a 0.15 m stair); a rise
+    /// weighted by `w` leaves `√(s_max² − (w h)²)` (JVRC-1's dynamic 3.5: 0.33 m up a 0.10 m
+    /// stair).
     fn farthest(&self, f: usize, k: usize, lateral: f64) -> f64 {
         let (Some(from), Some(at)) = (self.along[f], self.surface[f]) else {
             return f64::INFINITY;
@@ -248,7 +254,11 @@ impl Footholds<'_> {
             let point = self.path.point(along, lateral);
             self.environment.surfaces[k].plane_elevation_at(point.x, point.y)
         };
-        let reach = |rise: f64| (self.s_max.powi(2) - rise.powi(2)).max(0.0).sqrt();
+        let reach = |rise: f64| {
+            (self.s_max.powi(2) - (self.rise_weight * rise).powi(2))
+                .max(0.0)
+                .sqrt()
+        };
         let flat = from + self.s_max;
         match (elevation(at, from), elevation(k, flat)) {
             (Some(start), Some(end)) => from + reach(end - start),
@@ -322,9 +332,12 @@ impl LandingRule for Footholds<'_> {
         let Some((extent, beside)) = self.choose(f, along, lateral, sole) else {
             return (0.0, None);
         };
+        // Coming up to the edge of its own surface is a step on the level: within `s_max`
+        // whatever the rise beyond the edge.
+        let level = along;
         let along = along.min(self.farthest(f, extent.surface, lateral));
         let fitted = self.fit(extent.surface, along, sole);
-        if let Some((edge, own)) = self.short_of(f, extent.surface, fitted, along, lateral, sole) {
+        if let Some((edge, own)) = self.short_of(f, extent.surface, fitted, level, lateral, sole) {
             return (edge - flat, Some(own));
         }
         // Clamped back by more than half its advance on the other foot, on the surface that
@@ -524,21 +537,21 @@ mod tests {
         rotated(&mut p, 4, LeftFoot, [0.0, 0.0, 0.2]);
         p.contacts[2][RightHand as usize] = true;
         let before = p.clone();
-        place_on_terrain(&mut p, &Environment::default(), &SOLE, ONE_FOOT);
+        place_on_terrain(&mut p, &Environment::default(), &SOLE, ONE_FOOT, 1.0);
         assert_eq!(p, before);
         // Not by the early return alone: a floor at z = 0 with room around the walk.
         let floor = Environment {
             surfaces: vec![block("floor", -1.0, 3.0, 0.0)],
             hand_affordances: Vec::new(),
         };
-        place_on_terrain(&mut p, &floor, &SOLE, ONE_FOOT);
+        place_on_terrain(&mut p, &floor, &SOLE, ONE_FOOT, 1.0);
         assert_eq!(p, before);
     }
 
     #[test]
     fn stairs_take_one_foot_per_tread_with_the_toes_clear_of_the_risers() {
         let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
         // Floor: its fit interval ends 0.03 + 0.1 before the riser at 0.5 (0.4 → 0.37). Each
         // tread's interval is [from + 0.15, to − 0.13], and a foot goes to its middle: a
         // landing on the tread the other foot stands on goes on to the next one.
@@ -565,7 +578,7 @@ mod tests {
     #[test]
     fn a_step_limit_shorter_than_two_treads_puts_both_feet_on_each_stair() {
         let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, 0.4);
+        place_on_terrain(&mut p, &stairs(), &SOLE, 0.4, 1.0);
         // The right foot, 0.46 m from tread-1's middle (0.66), first comes up to the floor's
         // edge (0.37) beside the left; the left goes up to tread-1 (0.29 m); the right, 0.59 m
         // on to tread-2 with one foot per stair, joins it on tread-1 instead, beside it, not
@@ -583,7 +596,7 @@ mod tests {
     #[test]
     fn short_steps_do_not_stall_at_an_edge() {
         let mut p = flat_walk(&[0.12, 0.24, 0.36, 0.48, 0.6, 0.72, 0.84, 0.96]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
         // 0.48 is clamped back to the floor's 0.37, 1 cm of its 12 cm advance on the right foot
         // (0.36): tread-1 instead, then one foot per tread.
         let on = [
@@ -599,7 +612,7 @@ mod tests {
     #[test]
     fn a_foot_comes_up_to_the_edge_before_a_step_onto_a_tread_longer_than_s_max() {
         let mut p = flat_walk(&[0.12, 0.24, 0.4, 0.48, 0.6, 0.72]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, 0.25);
+        place_on_terrain(&mut p, &stairs(), &SOLE, 0.25, 1.0);
         // The left foot, stalled at the floor's edge (0.37) beside the right, would go on to
         // tread-1 (0.66), 0.42 m from 0.24: it comes up to the edge instead. The right,
         // already there, goes on (0.29 m, the shortest step onto the tread), and the left
@@ -608,24 +621,39 @@ mod tests {
         assert_footholds(&p, &[&SHORT_STEPS[..], &on].concat());
     }
 
-    #[test]
-    fn the_step_limit_holds_in_space_down_a_stair() {
-        // A 0.15 m drop at x = 0.5 onto a floor whose fit interval starts at 0.65.
-        let drop = Environment {
+    /// A 0.15 m drop at x = 0.5 onto a floor whose fit interval starts at 0.65.
+    fn drop() -> Environment {
+        Environment {
             surfaces: vec![
                 block("landing", -1.0, 0.5, 0.15),
                 block("floor", 0.5, 3.0, 0.0),
             ],
             hand_affordances: Vec::new(),
-        };
+        }
+    }
+
+    #[test]
+    fn the_step_limit_holds_in_space_down_a_stair() {
         let mut p = flat_walk(&[0.2, 0.37, 0.9]);
-        place_on_terrain(&mut p, &drop, &SOLE, 0.48);
+        place_on_terrain(&mut p, &drop(), &SOLE, 0.48, 1.0);
         // The right foot's 0.48 m step from 0.2 would be 0.503 m in space: it lands
         // √(0.48² − 0.15²) = 0.456 m along instead, on the floor.
         let found = footholds(&p);
         let [x, z] = found[found.len() - 1];
         let along = (0.48f64.powi(2) - 0.15f64.powi(2)).sqrt();
         assert!((x - (0.2 + along)).abs() < 1e-12 && z == 0.0, "{found:?}");
+    }
+
+    #[test]
+    fn a_weighted_rise_shortens_a_step_down() {
+        // The drop above with the rise weighted 1.5: the right foot's step from 0.3 reaches
+        // √(0.48² − (1.5 · 0.15)²) = 0.424 m along instead of 0.456 m.
+        let mut p = flat_walk(&[0.3, 0.37, 0.9]);
+        place_on_terrain(&mut p, &drop(), &SOLE, 0.48, 1.5);
+        let found = footholds(&p);
+        let [x, z] = found[found.len() - 1];
+        let along = (0.48f64.powi(2) - (1.5f64 * 0.15).powi(2)).sqrt();
+        assert!((x - (0.3 + along)).abs() < 1e-12 && z == 0.0, "{found:?}");
     }
 
     /// A floor to x = 1.0 (its fit interval ends at 0.87) and a long platform 0.05 m up (its
@@ -643,7 +671,7 @@ mod tests {
     #[test]
     fn a_landing_its_surface_takes_past_s_max_comes_up_to_the_edge_first() {
         let mut p = flat_walk(&[0.2, 0.4, 0.6, 0.75, 1.05]);
-        place_on_terrain(&mut p, &platform(), &SOLE, 0.48);
+        place_on_terrain(&mut p, &platform(), &SOLE, 0.48, 1.0);
         // The right foot's landing at 1.05 is on the platform, whose fit interval starts 0.55 m
         // from the foot's 0.6: it comes up to the floor's edge instead.
         let found = footholds(&p);
@@ -651,9 +679,27 @@ mod tests {
     }
 
     #[test]
+    fn a_foot_comes_up_to_the_edge_on_the_level_whatever_the_weighted_rise_beyond() {
+        // The platform 0.185 m up with the rise weighted 3.5: no step up reaches (3.5 · 0.185 >
+        // 0.48), yet the right foot at 0.6 comes up to the floor's edge, 0.27 m on the level,
+        // instead of jumping on to the platform.
+        let riser = Environment {
+            surfaces: vec![
+                block("floor", -1.0, 1.0, 0.0),
+                block("platform", 1.0, 3.0, 0.185),
+            ],
+            hand_affordances: Vec::new(),
+        };
+        let mut p = flat_walk(&[0.2, 0.4, 0.6, 0.75, 1.05]);
+        place_on_terrain(&mut p, &riser, &SOLE, 0.48, 3.5);
+        let found = footholds(&p);
+        assert_eq!(found[found.len() - 1], [0.87, 0.0], "{found:?}");
+    }
+
+    #[test]
     fn a_stalled_landing_goes_on_to_a_long_surface_only_within_s_max() {
         let mut p = flat_walk(&[0.1, 0.2, 0.35, 0.55, 0.8, 1.0]);
-        place_on_terrain(&mut p, &platform(), &SOLE, 0.48);
+        place_on_terrain(&mut p, &platform(), &SOLE, 0.48, 1.0);
         // The left foot's landing at 1.0 is clamped back to 0.87, stalled beside the right
         // foot (0.8): on to the platform would be 0.60 m from 0.55, so it comes up to the edge.
         let found = footholds(&p);
@@ -663,7 +709,7 @@ mod tests {
     #[test]
     fn a_long_step_does_not_skip_a_tread() {
         let mut p = flat_walk(&[0.2, 0.3, 1.0]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
         // The right foot would land on tread-2 while the left stands on the floor: tread-1, in
         // the middle of its fit interval.
         let right = p.pose(p.len() - 1, RightFoot).translation.vector;
@@ -680,7 +726,7 @@ mod tests {
             contacts[RightHand as usize] = true;
         }
         let before = p.clone();
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
         let rise =
             |i: usize, e: EndEffector| p.pose(i, e).translation.z - before.pose(i, e).translation.z;
         // Stance 4: both feet on the floor; 6: the left foot on tread-1 (0.1), the right on the
@@ -711,7 +757,7 @@ mod tests {
             stance([-0.05, 0.1, 0.0], [-0.05, -0.1, 0.0], BOTH),
             stance([-0.05, 0.1, 0.0], [0.2, -0.1, 0.0], BOTH),
         ]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
         let (left, right) = (p.pose(0, LeftFoot), p.pose(0, RightFoot));
         let middle = (left.translation.vector + right.translation.vector) / 2.0;
         assert!(middle.xy().norm() < 1e-12, "{middle}");
@@ -739,7 +785,7 @@ mod tests {
             stance([0.3, 0.1, 0.0], [0.3, -0.1, 0.0], BOTH),
         ]);
         rotated(&mut p, 1, LeftFoot, [0.0, 0.0, 0.1]);
-        place_on_terrain(&mut p, &env, &SOLE, ONE_FOOT);
+        place_on_terrain(&mut p, &env, &SOLE, ONE_FOOT, 1.0);
         let left = p.pose(1, LeftFoot);
         assert!((left.translation.z - 0.3 * slope.tan()).abs() < 1e-12);
         let normal = env.surfaces[0].pose.rotation * Vector3::z();
@@ -763,7 +809,7 @@ mod tests {
             stance([0.6, 0.1, 0.0], [0.6, -0.1, 0.0], BOTH),
         ]);
         let before = p.clone();
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT);
+        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
         let rise = |i: usize| p.roots[i].translation.z - before.roots[i].translation.z;
         assert!(rise(0).abs() < 1e-12 && (rise(2) - 0.1).abs() < 1e-12);
         assert!((rise(1) - 0.05).abs() < 1e-12, "{}", rise(1));

@@ -4,7 +4,8 @@
 //! becomes phases:
 //! - a foot released (double → single support): a double-support phase (the ZMP crosses to the
 //!   foot that stays), at whose end the foot lifts off; it lasts `double_support_s`, the first
-//!   one `initial_double_support_s`, so the CoM can start from rest;
+//!   one `initial_double_support_s`, so the CoM can start from rest, and one next to a step up
+//!   or down (after its touchdown or before its lift-off) `step_double_support_s`;
 //! - a foot added (single → double support): the single-support phase in which it swings, from
 //!   lift-off through the highest post-processed swing pose of its flight to its contact pose;
 //!   it lasts `single_support_s` (a step up or down: `step_single_support_s`);
@@ -16,8 +17,8 @@
 //! A timed sequence sets the pace instead: a double support before a lift-off lasts the summed
 //! durations of the stances the walk stood in on both feet since the support's previous phase,
 //! a single support those of the stances its foot was in the air, each clamped into
-//! `timed_double_support_s` / `timed_single_support_s` (the first lift-off and a step up or down
-//! no shorter than their configured durations). A span with an untimed stance, and every other
+//! `timed_double_support_s` / `timed_single_support_s` (the first lift-off, a step up or down
+//! and the double support next to it no shorter than their configured durations). A span with an untimed stance, and every other
 //! phase, keeps the configured duration; each phase records where its duration came from
 //! ([`PhaseTiming`]).
 //!
@@ -109,6 +110,8 @@ struct Builder<'a> {
     /// The swing under way: its foot, the highest swing pose so far and its lift-off height.
     swing: Option<(EndEffector, Isometry3<f64>, f64)>,
     stepped: bool,
+    /// Whether the last touchdown ended a step up or down.
+    after_step: bool,
     /// The sequence's time in the current support since its previous phase.
     dwell: Dwell,
 }
@@ -153,6 +156,7 @@ impl FootstepPlan {
             feet: standing.map(Some),
             swing: None,
             stepped: false,
+            after_step: false,
             dwell: Dwell::Empty,
         };
         let mut hands = [false; 2];
@@ -162,7 +166,7 @@ impl FootstepPlan {
                 stance.contacts[EndEffector::LeftHand as usize],
                 stance.contacts[EndEffector::RightHand as usize],
             ];
-            builder.stance(stance, next_hands != hands);
+            builder.stance(stance, &stances[i + 1..], next_hands != hands);
             hands = next_hands;
             let phases = first_phase..builder.plan.phases.len();
             if !phases.is_empty() {
@@ -250,8 +254,9 @@ impl FootstepPlan {
 }
 
 impl Builder<'_> {
-    /// Adds the phases that lead from the current support to `stance`'s.
-    fn stance(&mut self, stance: &PreparedStance, hands_change: bool) {
+    /// Adds the phases that lead from the current support to `stance`'s; `upcoming` are the
+    /// stances after it.
+    fn stance(&mut self, stance: &PreparedStance, upcoming: &[PreparedStance], hands_change: bool) {
         let in_contact = FEET.map(|f| stance.contacts[f as usize]);
         let added = [0, 1].map(|f| in_contact[f] && self.feet[f].is_none());
         let released = [0, 1].map(|f| !in_contact[f] && self.feet[f].is_some());
@@ -268,9 +273,13 @@ impl Builder<'_> {
         }
         for f in 0..2 {
             if released[f] {
-                let duration = self.lift_off_double_support();
-                self.double_support(duration, Some(FEET[f]));
                 let lift_off_z = self.feet[f].map_or(0.0, |foot| foot.translation.z);
+                let step_ahead = upcoming
+                    .iter()
+                    .find(|s| s.contacts[FEET[f] as usize])
+                    .is_some_and(|s| is_step(lift_off_z, &s.targets[FEET[f] as usize]));
+                let duration = self.lift_off_double_support(step_ahead);
+                self.double_support(duration, Some(FEET[f]));
                 self.feet[f] = None;
                 self.swing = Some((FEET[f], stance.targets[FEET[f] as usize], lift_off_z));
             }
@@ -289,11 +298,16 @@ impl Builder<'_> {
 
     /// The double support that ends with a lift-off: the stances on both feet since the
     /// support's previous phase, if all timed, else `double_support_s`; the first lift-off from
-    /// standing no shorter than `initial_double_support_s` (the CoM starts from rest).
-    fn lift_off_double_support(&mut self) -> (f64, PhaseTiming) {
+    /// standing no shorter than `initial_double_support_s` (the CoM starts from rest), and one
+    /// after a step up or down or before one (`step_ahead`) no shorter than
+    /// `step_double_support()`.
+    fn lift_off_double_support(&mut self, step_ahead: bool) -> (f64, PhaseTiming) {
         let limits = self.timing.timed_double_support();
         let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
-        if self.stepped {
+        if self.stepped && (step_ahead || self.after_step) {
+            let step = self.timing.step_double_support();
+            timed(dwell, step, limits, step)
+        } else if self.stepped {
             timed(dwell, self.timing.double_support_s, limits, 0.0)
         } else {
             let initial = self.timing.initial_double_support_s;
@@ -311,7 +325,7 @@ impl Builder<'_> {
     ) -> (f64, PhaseTiming) {
         let limits = self.timing.timed_single_support();
         let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
-        if (landing.translation.z - lift_off_z).abs() > STEP_HEIGHT_M {
+        if is_step(lift_off_z, landing) {
             let step = self.timing.step_single_support();
             timed(dwell, step, limits, step)
         } else {
@@ -337,6 +351,7 @@ impl Builder<'_> {
         );
         self.feet[slot(foot)] = Some(landing);
         self.stepped = true;
+        self.after_step = is_step(lift_off_z, &landing);
     }
 
     fn double_support(&mut self, duration: (f64, PhaseTiming), lift_off: Option<EndEffector>) {
@@ -371,6 +386,12 @@ fn timed(dwell: Dwell, configured: f64, [min, max]: [f64; 2], floor: f64) -> (f6
 }
 
 /// Index of a foot in the `[_; 2]` arrays.
+/// Whether a swing from `lift_off_z` landing at `landing` steps up or down (a stair, a ramp):
+/// its heights differ by more than [`STEP_HEIGHT_M`].
+fn is_step(lift_off_z: f64, landing: &Isometry3<f64>) -> bool {
+    (landing.translation.z - lift_off_z).abs() > STEP_HEIGHT_M
+}
+
 fn slot(foot: EndEffector) -> usize {
     match foot {
         EndEffector::LeftFoot => 0,
@@ -448,6 +469,47 @@ mod tests {
             [timing.step_single_support(), timing.single_support_s]
         );
         assert!(timing.step_single_support() > timing.single_support_s);
+    }
+
+    #[test]
+    fn a_double_support_next_to_a_step_takes_the_step_double_support() {
+        let timing = DynamicGaitConfig::default();
+        let stances = [
+            stance(DS, standing()[0], standing()[1]),
+            // Left: a flat step; right, then left up 0.10 m; right, then left flat again.
+            stance(LEFT_UP, at(0.1, 0.1, 0.05), standing()[1]),
+            stance(DS, at(0.2, 0.1, 0.0), standing()[1]),
+            stance(RIGHT_UP, at(0.2, 0.1, 0.0), at(0.2, -0.1, 0.13)),
+            stance(DS, at(0.2, 0.1, 0.0), at(0.4, -0.1, 0.1)),
+            stance(LEFT_UP, at(0.4, 0.1, 0.13), at(0.4, -0.1, 0.1)),
+            stance(DS, at(0.6, 0.1, 0.1), at(0.4, -0.1, 0.1)),
+            stance(RIGHT_UP, at(0.6, 0.1, 0.1), at(0.6, -0.1, 0.13)),
+            stance(DS, at(0.6, 0.1, 0.1), at(0.8, -0.1, 0.1)),
+            stance(LEFT_UP, at(0.8, 0.1, 0.13), at(0.8, -0.1, 0.1)),
+            stance(DS, at(1.0, 0.1, 0.1), at(0.8, -0.1, 0.1)),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        let doubles: Vec<f64> = plan
+            .phases
+            .iter()
+            .filter(|p| matches!(p.support, Support::Double { .. }))
+            .map(|p| p.duration_s)
+            .collect();
+        let (step, flat) = (timing.step_double_support(), timing.double_support_s);
+        // The first lift-off from standing; before the right's step up; between the two steps
+        // up; after the left's step up; between two flat steps; the final rest.
+        assert_eq!(
+            doubles,
+            [
+                timing.initial_double_support_s,
+                step,
+                step,
+                step,
+                flat,
+                timing.final_double_support_s
+            ]
+        );
+        assert!((step - 2.2 * flat).abs() < 1e-12);
     }
 
     #[test]

@@ -280,6 +280,7 @@ impl DynamicWalker {
         let dynamic = &self.plan().config;
         ControllerConfig {
             hand_weight: dynamic.hand_weight.unwrap_or(config.hand_weight),
+            com_gain: dynamic.com_gain.unwrap_or(config.com_gain),
             ..*config
         }
     }
