@@ -18,9 +18,9 @@
 //! durations of the stances the walk stood in on both feet since the support's previous phase,
 //! a single support those of the stances its foot was in the air, each clamped into
 //! `timed_double_support_s` / `timed_single_support_s` (the first lift-off, a step up or down
-//! and the double support next to it no shorter than their configured durations). A span with an untimed stance, and every other
-//! phase, keeps the configured duration; each phase records where its duration came from
-//! ([`PhaseTiming`]).
+//! and the double support next to it no shorter than their configured durations). A span with
+//! an untimed stance, and every other phase, keeps the configured duration; each phase records
+//! where its duration came from ([`PhaseTiming`]).
 //!
 //! The walk ends with `final_double_support_s` of double support after the last touchdown; a
 //! sequence ending with a foot in the air is refused. The phases of each stance form a
