@@ -128,10 +128,10 @@ impl Pace {
     /// The pace that walks `generated` (laid out at `scale`, post-processed with
     /// `request.scf`) at `request.speed` with `gait`'s single and double supports: the supports
     /// are retimed so that their medians over the walk's complete steps are the gait's (each
-    /// stance within the robot's limits for its kind), then the path is stretched, with a
-    /// ramp of [`RAMP_STEPS`] median steps at each end, so that the walk's length over its stances' total
-    /// time (first and last stance left out: the gait starts and ends with its own standing
-    /// phases) is the speed.
+    /// stance within the robot's limits for its kind), then the path is stretched, with a ramp
+    /// of [`RAMP_STEPS`] median steps at each end, so that the walk's length over its stances'
+    /// total time (first and last stance left out: the gait starts and ends with its own
+    /// standing phases) is the speed.
     pub fn for_speed(
         model: &NgramModel,
         generated: &Generated,

@@ -434,6 +434,15 @@ mod tests {
         [at(0.0, 0.1, 0.0), at(0.0, -0.1, 0.0)]
     }
 
+    /// The durations of the plan's single supports (`single`) or double supports.
+    fn durations(plan: &FootstepPlan, single: bool) -> Vec<f64> {
+        plan.phases
+            .iter()
+            .filter(|p| matches!(p.support, Support::Single(_)) == single)
+            .map(|p| p.duration_s)
+            .collect()
+    }
+
     fn kinds(plan: &FootstepPlan) -> Vec<&'static str> {
         plan.phases
             .iter()
@@ -456,12 +465,7 @@ mod tests {
             stance(DS, at(0.3, 0.1, 0.1), at(0.3, -0.1, 0.005)),
         ];
         let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
-        let singles: Vec<f64> = plan
-            .phases
-            .iter()
-            .filter(|p| matches!(p.support, Support::Single(_)))
-            .map(|p| p.duration_s)
-            .collect();
+        let singles = durations(&plan, true);
         // The left foot up 0.10 m: a step; the right up 0.005 m: a flat step (its swing pose's
         // height does not count).
         assert_eq!(
@@ -489,12 +493,7 @@ mod tests {
             stance(DS, at(1.0, 0.1, 0.1), at(0.8, -0.1, 0.1)),
         ];
         let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
-        let doubles: Vec<f64> = plan
-            .phases
-            .iter()
-            .filter(|p| matches!(p.support, Support::Double { .. }))
-            .map(|p| p.duration_s)
-            .collect();
+        let doubles = durations(&plan, false);
         let (step, flat) = (timing.step_double_support(), timing.double_support_s);
         // The first lift-off from standing; before the right's step up; between the two steps
         // up; after the left's step up; between two flat steps; the final rest.
