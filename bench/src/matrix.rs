@@ -52,6 +52,10 @@ pub struct MatrixArgs {
     /// (0.1-10, the MuJoCo option `mass_scale`).
     #[arg(long, default_value_t = 1.0)]
     pub mass_scale: f64,
+    /// Friction stiffness in the simulator: MuJoCo's `impratio` (1-100; default MuJoCo's 1). At
+    /// 20 a sole loaded inside its friction cone does not creep (docs/mujoco.md, "Contacts").
+    #[arg(long, default_value_t = 1.0)]
+    pub impratio: f64,
     /// Model error in the simulator only: the pelvis CoM moved by x,y,z (m, pelvis frame; each
     /// within ±0.5, the MuJoCo option `pelvis_com_offset`).
     #[arg(
@@ -246,7 +250,8 @@ pub fn walk_matrix(
 }
 
 /// The options of every walk of the matrix: the gait's, with the command line's rate, model
-/// error and push; the model error is checked like every MuJoCo option, naming its flag.
+/// error, friction stiffness and push; those are checked like every MuJoCo option, naming the
+/// flags.
 pub fn walk_options(args: &MatrixArgs, gait: Gait) -> anyhow::Result<PhysicsWalkOptions> {
     let mut options = match gait {
         Gait::Dynamic => PhysicsWalkOptions::dynamic(),
@@ -255,6 +260,7 @@ pub fn walk_options(args: &MatrixArgs, gait: Gait) -> anyhow::Result<PhysicsWalk
     options.rate_hz = args.rate_hz;
     options.trace_every = 0;
     options.mujoco.mass_scale = args.mass_scale;
+    options.mujoco.impratio = args.impratio;
     if let Some(offset) = &args.pelvis_com_offset {
         let &[x, y, z] = offset.as_slice() else {
             anyhow::bail!(
@@ -266,7 +272,7 @@ pub fn walk_options(args: &MatrixArgs, gait: Gait) -> anyhow::Result<PhysicsWalk
     options
         .mujoco
         .check()
-        .context("--mass-scale / --pelvis-com-offset")?;
+        .context("--mass-scale / --pelvis-com-offset / --impratio")?;
     if let Some(path) = &args.scene {
         options.scene = Some(Arc::new(Scene::from_path(path)?));
     }

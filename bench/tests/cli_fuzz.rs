@@ -238,6 +238,7 @@ fn bench_flags() -> Vec<Flag> {
     for (flag, range) in [
         ("--rate-hz", Some(RATE_HZ)),
         ("--mass-scale", None),
+        ("--impratio", None),
         ("--pelvis-com-offset", None),
         ("--push-impulse", None),
         ("--push-step", None),

@@ -1,5 +1,6 @@
 //! The MuJoCo backend with the vendored robots: standing still in the configured posture,
-//! balancing on one foot, determinism, joint tracking, the adapter side and command checks.
+//! balancing on one foot, how far feet creep under a sideways load, determinism, joint tracking,
+//! the adapter side and command checks.
 //! Needs the `mujoco` feature (and the library: `eval "$(scripts/setup-mujoco.sh)"`).
 #![cfg(feature = "mujoco")]
 
@@ -12,7 +13,7 @@ use kinematics::configuration::Configuration;
 use kinematics::ik::{IkError, IkOptions, IkSolver, IkTarget};
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
-use nalgebra::{Isometry3, Vector2};
+use nalgebra::{Isometry3, Vector2, Vector3};
 use shm_types::SensorSample;
 use sim_adapter::RobotIo;
 use sim_adapter::SimulatedRobot;
@@ -521,4 +522,48 @@ fn the_adapter_side_reads_what_the_simulator_measures() {
     );
     let weight = robot.model.total_mass() * 9.81;
     assert!((sample.wrenches[0][2] + sample.wrenches[1][2] - weight).abs() < 0.01 * weight);
+}
+
+/// How far (m) JVRC-1's feet slide in 2 s while it stands pushed sideways at the pelvis by a
+/// tenth of its weight (its feet then carry that force, a tenth of what friction, μ = 1, holds),
+/// from 0.5 s after the push starts (the contacts' elastic give is over by then).
+fn sideways_creep(options: MujocoOptions) -> f64 {
+    let (robot, urdf) = robot("jvrc1");
+    let initial = robot.standing.clone();
+    let mut sim = MujocoSim::new(robot.clone(), &urdf, &initial, options).unwrap();
+    let q: Vec<f64> = robot.standing.joints.iter().copied().collect();
+    let qd = vec![0.0; q.len()];
+    hold_standing(&mut sim, 0.5);
+    let weight = robot.model.total_mass() * 9.81;
+    sim.set_pelvis_force(Vector3::new(0.0, 0.1 * weight, 0.0));
+    hold_standing(&mut sim, 0.5);
+    let feet = [EndEffector::LeftFoot, EndEffector::RightFoot];
+    let start = feet.map(|f| sim.end_effector_pose(f).translation.vector);
+    for _ in 0..1000 {
+        sim.step(&q, &qd, DT).unwrap();
+    }
+    assert!(!sim.has_fallen());
+    feet.iter()
+        .zip(start)
+        .map(|(&f, s)| {
+            (sim.end_effector_pose(f).translation.vector - s)
+                .xy()
+                .norm()
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_sole_loaded_sideways_inside_its_friction_cone_stays_put_at_a_high_impratio() {
+    let holding = sideways_creep(MujocoOptions {
+        impratio: 20.0,
+        ..MujocoOptions::default()
+    });
+    let creeping = sideways_creep(MujocoOptions::default());
+    // Measured: 0.05 mm at `impratio` 20, 1.2 mm at the default (MuJoCo's 1).
+    assert!(holding < 1e-4, "the feet crept {holding} m in 2 s");
+    assert!(
+        creeping > 10.0 * holding,
+        "the default creeps {creeping} m, not much more than {holding} m"
+    );
 }

@@ -92,8 +92,10 @@ pub fn walk_with<E: std::error::Error>(
 /// the first whose post-processed walk reaches the path's end is ended there
 /// ([`PostProcessedSequence::end_at`]). With both feet on every stair the terrain pass takes
 /// more footholds per metre than the flat walk has, and it cannot add stances; a longer flat
-/// walk than needed would only bring in more of the source's sideways wander.
-pub const TERRAIN_DISTANCE_MARGINS: [f64; 3] = [1.0, 1.5, 2.0];
+/// walk than needed would only bring in more of the source's sideways wander. Up and down the
+/// 15° ramp JVRC-1's steps are a third of its flat ones (the weighted rise): twice the path
+/// ended 1.1–1.5 m short of the goal, on the way down.
+pub const TERRAIN_DISTANCE_MARGINS: [f64; 4] = [1.0, 1.5, 2.0, 3.0];
 
 /// [`walk_with`] in `environment`, a scene's in the walk's frame
 /// ([`crate::Scene::walk_environment`]): the source's flat walk is put in it

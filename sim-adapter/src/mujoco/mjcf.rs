@@ -112,9 +112,10 @@ pub(crate) fn write(
     );
     let _ = writeln!(
         xml,
-        r#"  <option timestep="{}" integrator="implicitfast" gravity="0 0 -{}" cone="elliptic"/>"#,
+        r#"  <option timestep="{}" integrator="implicitfast" gravity="0 0 -{}" cone="elliptic" impratio="{}"/>"#,
         o.timestep,
-        kinematics::ground::GRAVITY
+        kinematics::ground::GRAVITY,
+        o.impratio
     );
     let _ = writeln!(xml, "  <default>");
     let _ = writeln!(
@@ -535,7 +536,8 @@ mod tests {
     #[test]
     fn without_a_terrain_the_model_is_the_flat_floor_one() {
         // Fingerprints and lengths of the documents written before terrain existed: flat walks
-        // simulate the same model as then, plus the palms and the wrist FT sites (4 lines).
+        // simulate the same model as then, plus the palms and the wrist FT sites (4 lines) and
+        // the friction's stiffness (`impratio`, an attribute of the option line).
         for (name, visual_geoms, hash, length) in [
             ("jvrc1", true, 0xf8c7_5ae0_ad90_45b8, 23057),
             ("jvrc1", false, 0x58e2_14e4_fe88_b33c, 18344),
@@ -554,7 +556,9 @@ mod tests {
                 .split_inclusive('\n')
                 .partition(|line| hands.iter().any(|name| line.contains(name.as_str())));
             assert_eq!(added.len(), 4, "{name}: {added:?}");
-            let xml = kept.concat();
+            let stiffness = format!(r#" impratio="{}""#, options.impratio);
+            assert_eq!(written.matches(&stiffness).count(), 1, "{name}");
+            let xml = kept.concat().replace(&stiffness, "");
             assert_eq!(
                 (fingerprint(&xml), xml.len()),
                 (hash, length),

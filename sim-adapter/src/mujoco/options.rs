@@ -30,6 +30,13 @@ pub struct MujocoOptions {
     pub joint_damping: f64,
     /// Sliding friction coefficient between the soles and the floor.
     pub friction: f64,
+    /// How much stiffer MuJoCo's soft contacts hold tangentially than normally (its
+    /// `impratio`, elliptic cones; default MuJoCo's 1). At 1 a sole loaded sideways inside its
+    /// friction cone creeps: each stance of JVRC-1 walking up the 15° ramp slid 3 mm down it,
+    /// and at 20 it stays put (the Coulomb limit `friction` is the same). An experiment's option
+    /// (`physics-matrix --impratio`) until the static gait damps its own rocking, which the creep
+    /// damps today (docs/mujoco.md, "Contacts").
+    pub impratio: f64,
     /// Height of the foot collision boxes (m); their bottom face lies on the sole plane.
     pub sole_thickness: f64,
     /// Contact time constant (s) of MuJoCo's soft contacts (`solref`); at least 2 × `timestep`.
@@ -66,6 +73,7 @@ impl Default for MujocoOptions {
             armature: 0.2,
             joint_damping: 0.0,
             friction: 1.0,
+            impratio: 1.0,
             sole_thickness: 0.02,
             contact_time_constant: 0.005,
             fall_height_fraction: 0.7,
@@ -109,6 +117,7 @@ impl MujocoOptions {
             Bound::new("armature", self.armature, 0.0, 100.0),
             Bound::new("joint_damping", self.joint_damping, 0.0, 1e4),
             Bound::new("friction", self.friction, 0.0, 10.0),
+            Bound::new("impratio", self.impratio, 1.0, 100.0),
             Bound::new("sole_thickness", self.sole_thickness, 1e-3, 0.2),
             Bound::new(
                 "contact_time_constant",
@@ -166,6 +175,14 @@ mod tests {
                 },
                 "friction",
                 "must be in [0, 10]",
+            ),
+            (
+                MujocoOptions {
+                    impratio: 0.5,
+                    ..defaults
+                },
+                "impratio",
+                "must be in [1, 100]",
             ),
             (
                 MujocoOptions {
