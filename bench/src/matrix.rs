@@ -52,9 +52,10 @@ pub struct MatrixArgs {
     /// (0.1-10, the MuJoCo option `mass_scale`).
     #[arg(long, default_value_t = 1.0)]
     pub mass_scale: f64,
-    /// Friction stiffness in the simulator: MuJoCo's `impratio` (1-100; default MuJoCo's 1). At
-    /// 20 a sole loaded inside its friction cone does not creep (docs/mujoco.md, "Contacts").
-    #[arg(long, default_value_t = 1.0)]
+    /// Friction stiffness in the simulator: MuJoCo's `impratio` (1-100; default 20, where a sole
+    /// loaded inside its friction cone does not creep; at MuJoCo's own 1 it does:
+    /// docs/mujoco.md, "Contacts").
+    #[arg(long, default_value_t = 20.0)]
     pub impratio: f64,
     /// Model error in the simulator only: the pelvis CoM moved by x,y,z (m, pelvis frame; each
     /// within ±0.5, the MuJoCo option `pelvis_com_offset`).

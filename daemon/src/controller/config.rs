@@ -8,6 +8,8 @@ use kinematics::config_file::toml_message;
 use kinematics::{ConfigFile, ConfigFileError};
 use serde::Deserialize;
 
+use super::gait::force_difference_bounds;
+
 /// The section [`ControllerConfig`] is read from.
 const SECTION: &str = "controller";
 
@@ -161,6 +163,13 @@ pub struct ControllerConfig {
     pub max_target_step_m: f64,
     /// Longest planned duration of one phase (s); with `phase_timeout_s` it bounds every phase.
     pub max_phase_s: f64,
+    /// The static gait's force-difference control in double support (m/s per N; 0: off): the
+    /// feet move vertically against each other until their normal forces split as the CoM
+    /// set-point asks. It damps the robot's rocking from foot to foot, which stiff friction
+    /// does not (docs/controller.md, "Force difference in the static gait").
+    pub force_difference_gain: f64,
+    /// Fastest the force difference moves the feet against each other (m/s).
+    pub force_difference_max_speed: f64,
 }
 
 impl Default for ControllerConfig {
@@ -223,6 +232,8 @@ impl Default for ControllerConfig {
             workspace_height_m: 3.0,
             max_target_step_m: 1.0,
             max_phase_s: 60.0,
+            force_difference_gain: 1e-5,
+            force_difference_max_speed: 0.02,
         }
     }
 }
@@ -295,7 +306,7 @@ impl ControllerConfig {
     /// The section's table: every numeric key, its value and its range, one line a key.
     pub fn bounds(&self) -> Vec<Bound> {
         let ticks = f64::from(self.touchdown_debounce_ticks);
-        vec![
+        let mut bounds = vec![
             Bound::new("com_weight", self.com_weight, 1e-6, 1e6),
             Bound::new("foot_weight", self.foot_weight, 1e-6, 1e6),
             Bound::new("hand_weight", self.hand_weight, 1e-6, 1e6),
@@ -427,7 +438,12 @@ impl ControllerConfig {
             Bound::new("workspace_height_m", self.workspace_height_m, 0.01, 10.0),
             Bound::new("max_target_step_m", self.max_target_step_m, 0.01, 10.0),
             Bound::new("max_phase_s", self.max_phase_s, 0.1, 120.0),
-        ]
+        ];
+        bounds.extend(force_difference_bounds(
+            self.force_difference_gain,
+            self.force_difference_max_speed,
+        ));
+        bounds
     }
 }
 

@@ -12,6 +12,7 @@ use kinematics::robot::{EndEffector, SoleRectangle};
 use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
 
 use super::config::ControllerConfig;
+use super::gait::{distribute, force_difference};
 use super::plan::{Step, TransitionPlan};
 use super::sequence::PreparedSequence;
 use super::status::{FaultCode, Phase};
@@ -29,6 +30,9 @@ pub(crate) struct Feedback<'a> {
     pub poses: &'a [Isometry3<f64>; 4],
     /// FT normal (world z) force by `EndEffector` (N).
     pub normal_forces: [f64; 4],
+    /// The forces are this tick's measurement (false: it was invalid and the state was advanced
+    /// by the commands, so no force is to be trusted for control).
+    pub measured: bool,
 }
 
 /// A pose set-point with its feed-forward velocity (linear xyz, angular xyz, world).
@@ -314,13 +318,34 @@ impl StateMachine {
                     self.finish_step(feedback);
                     if !self.advance(feedback) {
                         self.refresh_targets(&feedback.pelvis);
+                        self.targets.contact_velocity = [[0.0; 6]; 2];
                         return Progress::Done;
                     }
                 }
             }
         }
         self.refresh_targets(&feedback.pelvis);
+        self.comply(feedback);
         Progress::Running
+    }
+
+    /// Force-difference control in double support: see [`double_support_compliance`]. Off
+    /// with one foot in contact, and for a tick without measurement.
+    fn comply(&mut self, feedback: &Feedback) {
+        let [left, right] = FEET.map(|f| f as usize);
+        let gain = self.config.force_difference_gain;
+        let both_feet = self.targets.contacts[left] && self.targets.contacts[right];
+        self.targets.contact_velocity = if both_feet && feedback.measured && gain > 0.0 {
+            double_support_compliance(
+                self.targets.com,
+                [&self.targets.anchors[left], &self.targets.anchors[right]],
+                &self.sole,
+                [feedback.normal_forces[left], feedback.normal_forces[right]],
+                (gain, self.config.force_difference_max_speed),
+            )
+        } else {
+            [[0.0; 6]; 2]
+        };
     }
 
     fn sequence(&self) -> &PreparedSequence {
@@ -693,6 +718,31 @@ impl StateMachine {
     }
 }
 
+/// The static gait's force-difference control in double support (Kajita et al. 2010; the
+/// dynamic gait's, `gait::force_difference`), as velocities of the feet (left, right): they move
+/// vertically against each other until their normal forces `forces` (N) split as the CoM
+/// set-point `com` asks, by the lever rule between the soles at `feet`. `gain`: m/s per N and
+/// the bound (m/s). A robot held stiffly by its joints rocks from one foot onto the other as a
+/// rigid block (an arm's reach, a shift of the CoM excite it); pressing the foot that lost its
+/// load back down damps that.
+fn double_support_compliance(
+    com: Vector2<f64>,
+    feet: [&Isometry3<f64>; 2],
+    sole: &SoleRectangle,
+    forces: [f64; 2],
+    (gain, max): (f64, f64),
+) -> [[f64; 6]; 2] {
+    let mut velocities = [[0.0; 6]; 2];
+    if let [Some(left), Some(right)] = distribute(com, feet.map(Some), sole, 0.0, 0.0) {
+        let total = forces[0] + forces[1];
+        let desired = [left.share * total, right.share * total];
+        let v = force_difference(desired, forces, gain, max);
+        velocities[0][2] = -v / 2.0;
+        velocities[1][2] = v / 2.0;
+    }
+    velocities
+}
+
 enum StepStatus {
     Running,
     Complete,
@@ -745,5 +795,45 @@ mod tests {
             rise: -0.1,
         };
         assert!((down.height(2.0, 2.0).height - 0.75).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_force_difference_presses_down_the_foot_that_lost_its_load() {
+        let sole = SoleRectangle {
+            length: 0.2,
+            width: 0.08,
+        };
+        let left = Isometry3::translation(0.0, 0.1, 0.0);
+        let right = Isometry3::translation(0.0, -0.1, 0.0);
+        let (gain, max) = (1e-5, 0.02);
+        let at_centre = |forces| {
+            double_support_compliance(
+                Vector2::zeros(),
+                [&left, &right],
+                &sole,
+                forces,
+                (gain, max),
+            )
+        };
+        // Rocked onto the left foot: the left rises, the right presses down, by 1e-5 × 400 N.
+        let v = at_centre([500.0, 100.0]);
+        assert!((v[0][2] - 2e-3).abs() < 1e-12 && (v[1][2] + 2e-3).abs() < 1e-12);
+        assert!(
+            v.iter()
+                .flat_map(|foot| [foot[0], foot[1], foot[3], foot[4], foot[5]])
+                .all(|c| c == 0.0)
+        );
+        // Split as asked: nothing moves; a large error moves at the bound, shared by both feet.
+        assert_eq!(at_centre([300.0, 300.0]), [[0.0; 6]; 2]);
+        assert!((at_centre([1e6, 0.0])[0][2] - max / 2.0).abs() < 1e-12);
+        // The CoM set-point over the right sole: the right foot should carry everything.
+        let over_right = double_support_compliance(
+            Vector2::new(0.0, -0.1),
+            [&left, &right],
+            &sole,
+            [300.0, 300.0],
+            (gain, max),
+        );
+        assert!(over_right[1][2] < 0.0, "the right foot presses down");
     }
 }

@@ -543,6 +543,7 @@ impl Controller {
             pelvis: *self.kinematics.link_pose(self.robot.base_link),
             poses: &self.poses,
             normal_forces: measurement.wrenches.map(|w| w[2]),
+            measured,
         };
         let (robot, kinematics) = (&self.robot, &self.kinematics);
         let sensors = || Sensors {

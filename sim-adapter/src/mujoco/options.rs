@@ -31,11 +31,10 @@ pub struct MujocoOptions {
     /// Sliding friction coefficient between the soles and the floor.
     pub friction: f64,
     /// How much stiffer MuJoCo's soft contacts hold tangentially than normally (its
-    /// `impratio`, elliptic cones; default MuJoCo's 1). At 1 a sole loaded sideways inside its
-    /// friction cone creeps: each stance of JVRC-1 walking up the 15° ramp slid 3 mm down it,
-    /// and at 20 it stays put (the Coulomb limit `friction` is the same). An experiment's option
-    /// (`physics-matrix --impratio`) until the static gait damps its own rocking, which the creep
-    /// damps today (docs/mujoco.md, "Contacts").
+    /// `impratio`, elliptic cones; default 20, MuJoCo's own is 1). At 1 a sole loaded sideways
+    /// inside its friction cone creeps, as a rubber sole on a floor does not: each stance of
+    /// JVRC-1 walking up the 15° ramp slid 3 mm down it, and at 20 it stays put (the Coulomb
+    /// limit `friction` is the same; docs/mujoco.md, "Contacts").
     pub impratio: f64,
     /// Height of the foot collision boxes (m); their bottom face lies on the sole plane.
     pub sole_thickness: f64,
@@ -73,7 +72,7 @@ impl Default for MujocoOptions {
             armature: 0.2,
             joint_damping: 0.0,
             friction: 1.0,
-            impratio: 1.0,
+            impratio: 20.0,
             sole_thickness: 0.02,
             contact_time_constant: 0.005,
             fall_height_fraction: 0.7,

@@ -96,15 +96,11 @@ pub(crate) fn foot_damping(
 }
 
 /// The force-difference velocity `v` (m/s; the left foot moves by `−v/2`, the right by `+v/2`)
-/// for desired and measured normal forces (left, right; N).
-pub(crate) fn force_difference(
-    desired: [f64; 2],
-    measured: [f64; 2],
-    config: &StabilizerConfig,
-) -> f64 {
+/// for desired and measured normal forces (left, right; N), with gain `gain` (m/s per N) and
+/// bound `max` (m/s). The static gait uses it too (`StateMachine`).
+pub(crate) fn force_difference(desired: [f64; 2], measured: [f64; 2], gain: f64, max: f64) -> f64 {
     let error = (desired[0] - desired[1]) - (measured[0] - measured[1]);
-    let max = config.force_difference_max_speed;
-    (config.force_difference_gain * error).clamp(-max, max)
+    (gain * error).clamp(-max, max)
 }
 
 /// The tilt damping's ankle rotation, kept `K_d θ̇` through the velocity of the feet in contact.
@@ -264,10 +260,12 @@ mod tests {
     #[test]
     fn force_difference_lowers_the_foot_that_should_carry_more() {
         let config = StabilizerConfig::default();
-        let v = force_difference([400.0, 200.0], [300.0, 300.0], &config);
-        assert!(v > 0.0, "the left foot (−v/2) presses down");
-        assert!(
-            force_difference([1e9, 0.0], [0.0, 0.0], &config) <= config.force_difference_max_speed
+        let (gain, max) = (
+            config.force_difference_gain,
+            config.force_difference_max_speed,
         );
+        let v = force_difference([400.0, 200.0], [300.0, 300.0], gain, max);
+        assert!(v > 0.0, "the left foot (−v/2) presses down");
+        assert!(force_difference([1e9, 0.0], [0.0, 0.0], gain, max) <= max);
     }
 }

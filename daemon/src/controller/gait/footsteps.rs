@@ -405,6 +405,7 @@ mod tests {
     use nalgebra::{DVector, Translation3};
 
     use super::*;
+    use crate::controller::gait::config::STEP_DOUBLE_SUPPORT_FACTOR;
 
     const LF: usize = EndEffector::LeftFoot as usize;
     const RF: usize = EndEffector::RightFoot as usize;
@@ -508,7 +509,7 @@ mod tests {
                 timing.final_double_support_s
             ]
         );
-        assert!((step - 2.2 * flat).abs() < 1e-12);
+        assert!((step - STEP_DOUBLE_SUPPORT_FACTOR * flat).abs() < 1e-12);
     }
 
     #[test]

@@ -697,7 +697,11 @@ impl DynamicWalker {
         }
         if let (true, [Some(left), Some(right)]) = (config.force_difference, loads) {
             let desired = [left.share * total, right.share * total];
-            let v = force_difference(desired, forces, &config);
+            let (gain, max) = (
+                config.force_difference_gain,
+                config.force_difference_max_speed,
+            );
+            let v = force_difference(desired, forces, gain, max);
             self.targets.contact_velocity[0][2] = -v / 2.0;
             self.targets.contact_velocity[1][2] = v / 2.0;
         }
