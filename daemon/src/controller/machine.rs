@@ -12,7 +12,7 @@ use kinematics::robot::{EndEffector, SoleRectangle};
 use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
 
 use super::config::ControllerConfig;
-use super::gait::{distribute, force_difference};
+use super::gait::{distribute, force_difference_velocities};
 use super::plan::{Step, TransitionPlan};
 use super::sequence::PreparedSequence;
 use super::status::{FaultCode, Phase};
@@ -719,7 +719,7 @@ impl StateMachine {
 }
 
 /// The static gait's force-difference control in double support (Kajita et al. 2010; the
-/// dynamic gait's, `gait::force_difference`), as velocities of the feet (left, right): they move
+/// dynamic gait's, `gait::force_difference_velocities`), as velocities of the feet (left, right): they move
 /// vertically against each other until their normal forces `forces` (N) split as the CoM
 /// set-point `com` asks, by the lever rule between the soles at `feet`. `gain`: m/s per N and
 /// the bound (m/s). A robot held stiffly by its joints rocks from one foot onto the other as a
@@ -734,11 +734,9 @@ fn double_support_compliance(
 ) -> [[f64; 6]; 2] {
     let mut velocities = [[0.0; 6]; 2];
     if let [Some(left), Some(right)] = distribute(com, feet.map(Some), sole, 0.0, 0.0) {
-        let total = forces[0] + forces[1];
-        let desired = [left.share * total, right.share * total];
-        let v = force_difference(desired, forces, gain, max);
-        velocities[0][2] = -v / 2.0;
-        velocities[1][2] = v / 2.0;
+        let [vl, vr] = force_difference_velocities([left.share, right.share], forces, gain, max);
+        velocities[0][2] = vl;
+        velocities[1][2] = vr;
     }
     velocities
 }

@@ -97,10 +97,25 @@ pub(crate) fn foot_damping(
 
 /// The force-difference velocity `v` (m/s; the left foot moves by `−v/2`, the right by `+v/2`)
 /// for desired and measured normal forces (left, right; N), with gain `gain` (m/s per N) and
-/// bound `max` (m/s). The static gait uses it too (`StateMachine`).
-pub(crate) fn force_difference(desired: [f64; 2], measured: [f64; 2], gain: f64, max: f64) -> f64 {
+/// bound `max` (m/s).
+fn force_difference(desired: [f64; 2], measured: [f64; 2], gain: f64, max: f64) -> f64 {
     let error = (desired[0] - desired[1]) - (measured[0] - measured[1]);
     (gain * error).clamp(-max, max)
+}
+
+/// The vertical velocities (left, right; m/s) of two feet in contact that split their measured
+/// normal forces `forces` (N) by the desired `shares`: [`force_difference`] shared between
+/// them. Both gaits' force-difference control.
+pub(crate) fn force_difference_velocities(
+    shares: [f64; 2],
+    forces: [f64; 2],
+    gain: f64,
+    max: f64,
+) -> [f64; 2] {
+    let total = forces[0] + forces[1];
+    let desired = shares.map(|share| share * total);
+    let v = force_difference(desired, forces, gain, max);
+    [-v / 2.0, v / 2.0]
 }
 
 /// The tilt damping's ankle rotation, kept `K_d θ̇` through the velocity of the feet in contact.

@@ -27,7 +27,7 @@ use kinematics::ground::sole_corners;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::Robot;
 
-pub(crate) use compliance::{distribute, force_difference};
+pub(crate) use compliance::{distribute, force_difference_velocities};
 pub(crate) use config::force_difference_bounds;
 pub use config::{DynamicGaitConfig, GaitConfig, StabilizerConfig};
 pub(crate) use walker::{DynamicWalker, Sensors};

@@ -39,7 +39,7 @@ use kinematics::robot::{EndEffector, SoleRectangle};
 use nalgebra::{DVector, Isometry3, UnitQuaternion, Vector2, Vector3};
 
 use super::DynamicPlan;
-use super::compliance::{TiltDamping, distribute, foot_damping, force_difference};
+use super::compliance::{TiltDamping, distribute, foot_damping, force_difference_velocities};
 use super::elevation::support_elevation;
 use super::footsteps::{FEET, Support, SupportPhase, SwingPlan};
 use super::sensing::{DcmEstimator, TiltRate, pressure_centre, tilted_com};
@@ -678,10 +678,6 @@ impl DynamicWalker {
         let inward = self.plan().config.zmp_inward_offset_m;
         let loads = distribute(zmp, feet, &self.sole, config.zmp_margin_m, inward);
         let forces = FEET.map(|f| sensors.wrenches[f as usize][2]);
-        let total: f64 = (0..2)
-            .filter(|&f| feet[f].is_some())
-            .map(|f| forces[f])
-            .sum();
         for f in 0..2 {
             let (Some(load), true) = (loads[f], config.foot_damping) else {
                 self.foot_turn[f] = Vector2::zeros();
@@ -696,14 +692,14 @@ impl DynamicWalker {
             }
         }
         if let (true, [Some(left), Some(right)]) = (config.force_difference, loads) {
-            let desired = [left.share * total, right.share * total];
-            let (gain, max) = (
+            let [vl, vr] = force_difference_velocities(
+                [left.share, right.share],
+                forces,
                 config.force_difference_gain,
                 config.force_difference_max_speed,
             );
-            let v = force_difference(desired, forces, gain, max);
-            self.targets.contact_velocity[0][2] = -v / 2.0;
-            self.targets.contact_velocity[1][2] = v / 2.0;
+            self.targets.contact_velocity[0][2] = vl;
+            self.targets.contact_velocity[1][2] = vr;
         }
         if let (true, Some(imu)) = (config.tilt_damping, &sensors.imu) {
             let rate = self.tilt_rate.update(imu, dt, config.tilt_rate_filter_s);
