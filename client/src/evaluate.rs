@@ -24,6 +24,7 @@
 
 pub mod actuators;
 pub(crate) mod balance;
+pub(crate) mod clearance;
 pub mod fig6;
 pub mod filmstrip;
 pub mod footholds;
@@ -300,6 +301,7 @@ impl RunResult {
             "time_per_step_s": self.steps.time_per_step_s,
             "terrain_collisions": self.steps.terrain_collisions,
             "foothold_error_m": self.steps.foothold_error_m,
+            "edge_clearance_m": self.steps.edge_clearance_m,
             "hand_support_share": self.hand_support_share,
             "requested_speed_m_s": self.requested_speed_m_s,
             "timing": self.timing,
@@ -588,8 +590,15 @@ fn run_once(
         (0..sequence.len()).map(|i| sequence.contacts(i)),
         &walk.targets,
     );
-    let steps = StepReport::of(&walk.states, walk.submitted_ns, walk.sim_s, &planned)
-        .context("no simulator truth recorded")?;
+    let edges = scene.map_or_else(Vec::new, |scene| clearance::edges(&scene.environment));
+    let steps = StepReport::of(
+        &walk.states,
+        walk.submitted_ns,
+        walk.sim_s,
+        &planned,
+        (&edges, &model.sole),
+    )
+    .context("no simulator truth recorded")?;
     let contacts: Vec<_> = (0..sequence.len()).map(|i| sequence.contacts(i)).collect();
     let hand_support_share = hands::support_share(
         &contacts,
@@ -692,6 +701,9 @@ fn describe_steps(steps: &StepReport) -> String {
     let climb = steps.end_elevation_m - steps.start_elevation_m;
     if climb.abs() >= 0.005 {
         let _ = write!(out, " climbed {climb:+.3} m");
+    }
+    if let Some(clearance) = steps.edge_clearance_m {
+        let _ = write!(out, " edge clearance {clearance:.3} m");
     }
     if steps.terrain_collisions > 0 {
         let _ = write!(out, " leg-terrain collisions {}", steps.terrain_collisions);

@@ -1,11 +1,12 @@
 //! Child processes: `walkd` and `walk-sim` started by `walkctl demo` and `walkctl evaluate`,
 //! the processes of the latency report, and those of the end-to-end tests. One implementation:
 //! each child's stderr goes to a temporary log (for error messages and for reading what it
-//! reported), it is stopped with SIGTERM and a grace period, and it is killed if dropped while
-//! it runs.
+//! reported), it is stopped with SIGTERM and a grace period, it is killed if dropped while it
+//! runs, and it gets SIGTERM from the kernel if the thread that started it dies.
 
 use std::cell::RefCell;
 use std::ffi::{OsStr, OsString};
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -20,7 +21,10 @@ use stance::Gait;
 /// How long a child may take to exit after SIGTERM before it is killed.
 pub const STOP_TIMEOUT: Duration = Duration::from_secs(5);
 
-/// A child process whose stderr goes to a temporary log file; killed if dropped while it runs.
+/// A child process whose stderr goes to a temporary log file; killed if dropped while it runs,
+/// and sent SIGTERM by the kernel when the thread that started it dies, so a `walkctl demo` or
+/// `evaluate` killed outright (SIGKILL, a crash) leaves no `walkd` and `walk-sim` behind: in
+/// lockstep the two would otherwise step each other on, at full speed, until killed by hand.
 pub struct Process {
     name: String,
     child: RefCell<Child>,
@@ -47,6 +51,22 @@ pub fn sibling(name: &str) -> anyhow::Result<PathBuf> {
     Ok(path)
 }
 
+/// In a forked child before `exec`: asks the kernel for SIGTERM when the thread that forked it
+/// dies (`PR_SET_PDEATHSIG`), and gives up if `parent` already died before that took effect.
+fn die_with_parent(parent: u32) -> std::io::Result<()> {
+    // SAFETY: prctl with PR_SET_PDEATHSIG and a signal number has no memory-safety
+    // preconditions; getppid has none.
+    unsafe {
+        if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM) != 0 {
+            return Err(std::io::Error::last_os_error());
+        }
+        if libc::getppid() as u32 != parent {
+            return Err(std::io::Error::from_raw_os_error(libc::ESRCH));
+        }
+    }
+    Ok(())
+}
+
 impl Process {
     /// Starts `program` with `args` and the extra environment `env`.
     pub fn start(
@@ -61,12 +81,20 @@ impl Process {
         static COUNT: AtomicU32 = AtomicU32::new(0);
         let n = COUNT.fetch_add(1, Ordering::Relaxed);
         let log = std::env::temp_dir().join(format!("walk-{}-{name}-{n}.log", std::process::id()));
-        let child = Command::new(program)
+        let mut command = Command::new(program);
+        command
             .args(args)
             .envs(env.iter().copied())
             .stdin(Stdio::null())
             .stdout(Stdio::null())
-            .stderr(std::fs::File::create(&log)?)
+            .stderr(std::fs::File::create(&log)?);
+        let parent = std::process::id();
+        // SAFETY: the closure runs in the forked child before `exec` and makes only
+        // async-signal-safe system calls (prctl, getppid), allocating nothing.
+        unsafe {
+            command.pre_exec(move || die_with_parent(parent));
+        }
+        let child = command
             .spawn()
             .with_context(|| format!("cannot start {}", program.display()))?;
         Ok(Self {

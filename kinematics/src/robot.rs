@@ -565,7 +565,8 @@ impl Loader<'_> {
             return Err(self.invalid(
                 "standing",
                 format!(
-                    "the posture puts the soles at different heights ({:.4} m apart)",
+                    "the posture puts the soles at different heights ({:.3e} m apart, more than \
+                     {FLAT_TOLERANCE:e} m); both must stand on the floor",
                     (left.z - right.z).abs()
                 ),
             ));

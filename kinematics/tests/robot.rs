@@ -364,3 +364,23 @@ fn a_palm_radius_out_of_range_is_refused_by_name() {
         &["palm_radius", "0.5"],
     );
 }
+
+#[test]
+fn soles_at_different_heights_are_refused_with_the_measured_gap() {
+    // Parallel soles (hip + knee + ankle pitch still zero), the right one a few µm higher: the
+    // message gives the gap in a precision that shows it, and the tolerance it exceeds.
+    let message = load_error(&edited_jvrc1(
+        |t| {
+            t.replace("R_HIP_P = -0.38", "R_HIP_P = -0.38002")
+                .replace("R_KNEE = 0.76", "R_KNEE = 0.76004")
+                .replace("R_ANKLE_P = -0.38", "R_ANKLE_P = -0.38002")
+        },
+        "heights",
+    ));
+    assert!(
+        message.contains("soles at different heights")
+            && message.contains("more than 1e-6 m")
+            && !message.contains("0.0000 m"),
+        "{message}"
+    );
+}

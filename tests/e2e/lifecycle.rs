@@ -260,3 +260,66 @@ fn the_minimal_adapter_example_serves_walkd_and_exits_cleanly() {
         walkd.log()
     );
 }
+
+/// The processes a `walkctl demo` started die with it, also when it is killed outright: a
+/// `walkd` and a `walk-sim` left behind in lockstep step each other on at full speed.
+#[test]
+fn a_killed_walkctl_takes_its_walkd_and_walk_sim_with_it() {
+    let prefix = unique_prefix("killed_walkctl");
+    let mut demo = std::process::Command::new(walk_tests::bin_dir().join("walkctl"))
+        .args([
+            "demo",
+            "--robot",
+            "jvrc1",
+            "--clock",
+            "realtime",
+            "--distance",
+            "5",
+        ])
+        .args([
+            "--config",
+            &walk_tests::config("jvrc1").display().to_string(),
+        ])
+        .args(["--service-prefix", &prefix])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("walkctl runs (build the binaries first)");
+    let children_of = |pid: u32| -> Vec<u32> {
+        std::fs::read_to_string(format!("/proc/{pid}/task/{pid}/children"))
+            .unwrap_or_default()
+            .split_whitespace()
+            .filter_map(|p| p.parse().ok())
+            .collect()
+    };
+    // Both children up and the link fresh: the demo is walking.
+    let _client = connect_when_fresh(&prefix, START).unwrap();
+    let children = children_of(demo.id());
+    assert_eq!(children.len(), 2, "walkd and walk-sim: {children:?}");
+
+    demo.kill().unwrap();
+    demo.wait().unwrap();
+    let alive = |pid: &u32| {
+        std::fs::read_to_string(format!("/proc/{pid}/stat")).is_ok_and(|stat| {
+            !stat
+                .rsplit(')')
+                .next()
+                .unwrap_or("")
+                .trim_start()
+                .starts_with('Z')
+        })
+    };
+    let start = Instant::now();
+    while children.iter().any(alive) && start.elapsed() < Duration::from_secs(10) {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let left: Vec<_> = children.iter().filter(|pid| alive(pid)).collect();
+    for pid in &left {
+        // SAFETY: kill on a pid this test saw as walkctl's child; no memory-safety conditions.
+        unsafe { libc::kill(**pid as libc::pid_t, libc::SIGKILL) };
+    }
+    assert!(
+        left.is_empty(),
+        "still running after walkctl died: {left:?}"
+    );
+}

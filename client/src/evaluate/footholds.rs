@@ -10,10 +10,12 @@
 //! than the one it left, a ramp). The touchdown's position is the sole frame's at the end of that
 //! window.
 
+use kinematics::robot::SoleRectangle;
 use serde::Serialize;
 use shm_types::SimTruth;
 
 use super::Points;
+use super::clearance::{Edge, edge_clearance_m};
 
 /// How far a sole must rise above where it rests for a swing to begin, and come down from the
 /// swing's highest point before it may count as landed (m): above the contact compliance, below
@@ -219,17 +221,22 @@ pub struct StepReport {
     /// The largest horizontal distance of a touchdown from the nearest planned foothold of the
     /// same foot (m); `None` without a touchdown.
     pub foothold_error_m: Option<f64>,
+    /// The least clearance of a swinging sole over a terrain edge, a stair's nosing
+    /// ([`super::clearance`], m); `None` when no swing passed over one (always on the flat
+    /// floor).
+    pub edge_clearance_m: Option<f64>,
 }
 
 impl StepReport {
     /// The report on the recorded `states` of a walk submitted at `submitted_ns` that ended
-    /// `walk_s` of simulated time later, against its `planned` footholds; `None` when nothing
-    /// was recorded.
+    /// `walk_s` of simulated time later, against its `planned` footholds and over the terrain's
+    /// `edges` for soles of size `sole`; `None` when nothing was recorded.
     pub(crate) fn of(
         states: &[SimTruth],
         submitted_ns: u64,
         walk_s: f64,
         planned: &PlannedFootholds,
+        (edges, sole): (&[Edge], &SoleRectangle),
     ) -> Option<Self> {
         let walk = since_submission(states, submitted_ns);
         let (start, end) = (walk.first()?, walk.last()?);
@@ -248,6 +255,7 @@ impl StepReport {
                 .map(|t| t / steps as f64),
             terrain_collisions: end.terrain_collisions,
             foothold_error_m: foothold_error_m(&swings, planned),
+            edge_clearance_m: edge_clearance_m(walk, &swings, edges, sole),
         })
     }
 
@@ -284,7 +292,14 @@ pub(crate) fn judged_on_terrain(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Vector3;
+    use crate::evaluate::clearance;
+    use nalgebra::{Isometry3, Vector3};
+    use stance::{Environment, SupportSurface};
+
+    const SOLE: SoleRectangle = SoleRectangle {
+        length: 0.2,
+        width: 0.08,
+    };
 
     const DT: f64 = 0.01;
 
@@ -472,7 +487,21 @@ mod tests {
         states.last_mut().unwrap().terrain_collisions = 3;
         let planned = planned_walk();
         // Submitted at the state stamped 11000 ns (t = 0.1 s); the walk ends 2.9 s later.
-        let report = StepReport::of(&states, 11_000, 2.9, &planned).unwrap();
+        // A stair whose nosing is at x = 0.15: coming down onto the tread (0.03 m arcs), the
+        // left sole (landing at x = 0.3) passes it lowest, 0.015 m up, as its heel leaves it.
+        let stair = Environment {
+            surfaces: vec![SupportSurface {
+                name: "tread".to_owned(),
+                pose: Isometry3::translation(0.3, 0.0, 0.185),
+                polygon: Some(vec![[-0.15, -0.5], [0.15, -0.5], [0.15, 0.5], [-0.15, 0.5]]),
+            }],
+            hand_affordances: Vec::new(),
+        };
+        let terrain = (clearance::edges(&stair), SOLE);
+        let report =
+            StepReport::of(&states, 11_000, 2.9, &planned, (&terrain.0, &terrain.1)).unwrap();
+        let edge = report.edge_clearance_m.unwrap();
+        assert!((0.014..0.018).contains(&edge), "{edge}");
         assert_eq!(report.start_elevation_m, 0.0);
         assert!((report.end_elevation_m - 0.185).abs() < 1e-12);
         assert_eq!((report.steps, report.planned_steps), (2, 2));
@@ -481,14 +510,15 @@ mod tests {
         assert!((per_step - 1.25).abs() < DT, "{per_step}");
         assert_eq!(report.terrain_collisions, 3);
         assert!((report.foothold_error_m.unwrap() - 0.06).abs() < 1e-9);
-        assert_eq!(StepReport::of(&[], 0, 1.0, &planned), None);
+        assert_eq!(StepReport::of(&[], 0, 1.0, &planned, (&[], &SOLE)), None);
     }
 
     #[test]
     fn a_standing_walk_has_no_steps() {
         let states = walk(1.0, still([0.0, 0.1, 0.5]), still([0.0, -0.1, 0.5]));
-        let report = StepReport::of(&states, 1000, 1.0, &planned_walk()).unwrap();
+        let report = StepReport::of(&states, 1000, 1.0, &planned_walk(), (&[], &SOLE)).unwrap();
         assert_eq!(report.steps, 0);
+        assert_eq!(report.edge_clearance_m, None);
         assert_eq!(report.time_per_step_s, None);
         assert_eq!(report.foothold_error_m, None);
         assert_eq!(report.start_elevation_m, 0.5);
@@ -504,6 +534,7 @@ mod tests {
             time_per_step_s: Some(1.0),
             terrain_collisions: 0,
             foothold_error_m: error,
+            edge_clearance_m: None,
         };
         let done = || (true, "done".to_owned());
         let near = report(Some(FOOTHOLD_BOUND_M));
