@@ -13,11 +13,13 @@
 //! edge the rectangle passes over, along the sole's normal, at each end of the part of the edge
 //! under the rectangle (a plane and a straight edge: the least is at an end). Negative: the
 //! edge is inside the foot box's bottom face, which MuJoCo's contact would not allow but for its
-//! compliance. Only a sole that is not rising counts (one rising moves away from what is under it,
-//! as a toe lifting off over the nosing of the tread it leaves), and only while it is
-//! [`TRAVELLED_M`] or more, horizontally, from where it stood before the swing and from where it
-//! came to rest: a sole setting down across a nosing is a foothold's matter (the foothold error),
-//! not a clearance. The walk's clearance is the least over its swings.
+//! compliance. Over an edge no higher than where the swing lifted off (up to [`DROP_M`] above:
+//! the nosing of the tread it steps down from) only a sole that is not rising counts: rising, it
+//! moves away from the edge, as a toe lifting off over that nosing; a toe rising past the nosing
+//! of a higher tread counts. And only while the sole is [`TRAVELLED_M`] or more, horizontally,
+//! from where it stood before the swing and from where it came to rest: a sole setting down
+//! across a nosing is a foothold's matter (the foothold error), not a clearance. The walk's
+//! clearance is the least over its swings.
 
 use kinematics::robot::SoleRectangle;
 use nalgebra::{Isometry3, Point2, Point3, Quaternion, Translation3, UnitQuaternion, Vector2};
@@ -115,15 +117,24 @@ pub(crate) fn edge_clearance_m(
             let p = sole_pose(&states[k], swing.foot).translation.vector;
             Point2::new(p.x, p.y)
         });
+        let lift_off_z = sole_pose(&states[first.saturating_sub(1)], swing.foot)
+            .translation
+            .z;
         for k in first.max(1)..last {
             let pose = sole_pose(&states[k], swing.foot);
             let at = Point2::new(pose.translation.x, pose.translation.y);
-            // A rising sole moves away from what is under it; it cannot catch it.
-            let rising = pose.translation.z > sole_pose(&states[k - 1], swing.foot).translation.z;
-            if rising || rests.iter().any(|rest| (at - rest).norm() < TRAVELLED_M) {
+            if rests.iter().any(|rest| (at - rest).norm() < TRAVELLED_M) {
                 continue;
             }
+            let rising = pose.translation.z > sole_pose(&states[k - 1], swing.foot).translation.z;
             for edge in edges {
+                // A sole rising away from an edge no higher than the one it left (the nosing
+                // of the tread it steps down from) cannot catch it; a toe rising past the
+                // nosing of a higher tread still can.
+                let below_lift_off = edge.from.z.max(edge.to.z) <= lift_off_z + DROP_M;
+                if rising && below_lift_off {
+                    continue;
+                }
                 if let Some(clearance) = clearance_over(&pose, edge, sole) {
                     least = Some(least.map_or(clearance, |l: f64| l.min(clearance)));
                 }
@@ -344,9 +355,16 @@ mod tests {
         let c = edge_clearance_m(&descent, &[landing_at([1.552, 0.0, 0.0])], &edges, &SOLE);
         let c = c.unwrap();
         assert!((c - 0.04).abs() < 1e-9, "{c}");
-        // A sole rising all the way over the nosing moves away from it: nothing to catch.
+        // A sole lifting off level with the nosing and rising all the way over it moves away
+        // from it: nothing to catch.
         let rising = states(1.0, |t| [0.85 + 0.3 * t, 0.0, 0.16 + 0.09 * t]);
         assert_eq!(edge_clearance_m(&rising, &[swing], &edges, &SOLE), None);
+        // One lifting off the floor and still rising as its toe passes the stair's nosing
+        // counts: here it passes 0.075 m too low (x = 0.75 → 1.15 while z = 0 → 0.2; its toe
+        // reaches the nosing at x = 1 with its centre at 0.9).
+        let climbing = states(1.0, |t| [0.75 + 0.4 * t, 0.0, 0.2 * t]);
+        let c = edge_clearance_m(&climbing, &[swing], &edges, &SOLE).unwrap();
+        assert!((c + 0.075).abs() < 0.005, "{c}");
         // A sole standing across the nosing outside any swing is not measured.
         let standing = states(1.0, |_| [1.0, 0.0, 0.15]);
         let later = Swing {
