@@ -16,6 +16,7 @@ use client::evaluate::{GroupSummary, MatrixCells, WalkRecord, group_by_cell, spe
 use kinematics::ConfigFile;
 use kinematics::bounds::Range;
 use serde::Serialize;
+use sim_adapter::mujoco::MujocoOptions;
 use stance::{Gait, Scene, WalkRequest};
 
 use crate::physics::{PhysicsWalkOptions, PhysicsWalkReport, Push, walk_distance};
@@ -55,7 +56,7 @@ pub struct MatrixArgs {
     /// Friction stiffness in the simulator: MuJoCo's `impratio` (1-100; default 20, where a sole
     /// loaded inside its friction cone does not creep; at MuJoCo's own 1 it does:
     /// docs/mujoco.md, "Contacts").
-    #[arg(long, default_value_t = 20.0)]
+    #[arg(long, default_value_t = MujocoOptions::default().impratio)]
     pub impratio: f64,
     /// Model error in the simulator only: the pelvis CoM moved by x,y,z (m, pelvis frame; each
     /// within ±0.5, the MuJoCo option `pelvis_com_offset`).

@@ -22,11 +22,12 @@
 //! clearance is the least over its swings.
 
 use kinematics::robot::SoleRectangle;
-use nalgebra::{Isometry3, Point2, Point3, Quaternion, Translation3, UnitQuaternion, Vector2};
+use nalgebra::{Isometry3, Point2, Point3, Vector2};
 use shm_types::SimTruth;
 use stance::Environment;
 
-use super::footholds::{REST_S, Swing};
+use super::footholds::{REST_S, Swing, sole_pose};
+use crate::observe::channels::isometry;
 
 /// How far the terrain must fall away beyond a polygon side for the side to be an edge (m):
 /// well above MuJoCo's contact compliance and a scene's tolerance between touching surfaces,
@@ -113,20 +114,19 @@ pub(crate) fn edge_clearance_m(
         }
         // Where the sole stood before the swing and where it came to rest: near either, it
         // lifts off or sets down, and an edge under it then is a foothold's matter.
-        let rests = [first.saturating_sub(1), last - 1].map(|k| {
-            let p = sole_pose(&states[k], swing.foot).translation.vector;
-            Point2::new(p.x, p.y)
-        });
-        let lift_off_z = sole_pose(&states[first.saturating_sub(1)], swing.foot)
-            .translation
-            .z;
+        let at = |k: usize| sole_pose(&states[k], swing.foot);
+        let rests = [first.saturating_sub(1), last - 1].map(|k| Point2::new(at(k)[0], at(k)[1]));
+        let lift_off_z = at(first.saturating_sub(1))[2];
         for k in first.max(1)..last {
-            let pose = sole_pose(&states[k], swing.foot);
-            let at = Point2::new(pose.translation.x, pose.translation.y);
-            if rests.iter().any(|rest| (at - rest).norm() < TRAVELLED_M) {
+            let p = at(k);
+            if rests
+                .iter()
+                .any(|rest| (Point2::new(p[0], p[1]) - rest).norm() < TRAVELLED_M)
+            {
                 continue;
             }
-            let rising = pose.translation.z > sole_pose(&states[k - 1], swing.foot).translation.z;
+            let rising = p[2] > at(k - 1)[2];
+            let pose = isometry(p);
             for edge in edges {
                 // A sole rising away from an edge no higher than the one it left (the nosing
                 // of the tread it steps down from) cannot catch it; a toe rising past the
@@ -142,19 +142,6 @@ pub(crate) fn edge_clearance_m(
         }
     }
     least
-}
-
-/// The sole frame of foot `foot` (0 left, 1 right) in `state`.
-fn sole_pose(state: &SimTruth, foot: usize) -> Isometry3<f64> {
-    let p = if foot == 0 {
-        &state.left_foot
-    } else {
-        &state.right_foot
-    };
-    Isometry3::from_parts(
-        Translation3::new(p[0], p[1], p[2]),
-        UnitQuaternion::from_quaternion(Quaternion::new(p[6], p[3], p[4], p[5])),
-    )
 }
 
 /// The least distance from the sole rectangle at `pose` to the part of `edge` under it, along

@@ -40,13 +40,18 @@ pub const FOOTHOLD_BOUND_M: f64 = 0.10;
 /// The feet in the order of the per-foot arrays here (as `stance::poses::FEET`).
 pub(crate) const FEET: [&str; 2] = ["left", "right"];
 
-/// The position of sole `foot` (0 left, 1 right) in `state` (world, m).
-fn sole(state: &SimTruth, foot: usize) -> [f64; 3] {
-    let pose = if foot == 0 {
+/// The pose `[x, y, z, qx, qy, qz, qw]` of sole `foot` (0 left, 1 right) in `state` (world).
+pub(crate) fn sole_pose(state: &SimTruth, foot: usize) -> &[f64; 7] {
+    if foot == 0 {
         &state.left_foot
     } else {
         &state.right_foot
-    };
+    }
+}
+
+/// The position of sole `foot` (0 left, 1 right) in `state` (world, m).
+fn sole(state: &SimTruth, foot: usize) -> [f64; 3] {
+    let pose = sole_pose(state, foot);
     [pose[0], pose[1], pose[2]]
 }
 

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use kinematics::robot::Robot;
-use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
+use nalgebra::Isometry3;
 use shm_types::{DaemonStatus, SimTruth};
 use stance::PostProcessedSequence;
 
@@ -17,6 +17,7 @@ use super::timing::PlannedPhase;
 use super::truth::{TruthRecorder, Verdict, state_at};
 use super::{BalanceSample, Points, TraceSample, align_targets};
 use crate::daemon_client::DaemonClient;
+use crate::observe::channels::isometry;
 use crate::observe::{Recorder, RecorderOutcome};
 
 /// What to record besides the status stream and the simulator's truth.
@@ -97,7 +98,7 @@ pub(crate) fn watch_walk(
     align_targets(
         &mut targets,
         sequence,
-        &[pose_of(&start.left_foot), pose_of(&start.right_foot)],
+        &[isometry(&start.left_foot), isometry(&start.right_foot)],
     );
     // Into the simulator's frame, where the footholds and Fig. 6 compare them with its truth.
     for target in &mut targets {
@@ -155,14 +156,6 @@ pub(crate) fn watch_walk(
         phases,
         recording,
     })
-}
-
-/// The pose a status carries as `[x, y, z, qx, qy, qz, qw]`.
-fn pose_of(pose: &[f64; 7]) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::new(pose[0], pose[1], pose[2]),
-        UnitQuaternion::from_quaternion(Quaternion::new(pose[6], pose[3], pose[4], pose[5])),
-    )
 }
 
 /// The trace sample of `status`, timed from `start`, against the target of its stance.

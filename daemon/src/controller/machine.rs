@@ -719,9 +719,9 @@ impl StateMachine {
 }
 
 /// The static gait's force-difference control in double support (Kajita et al. 2010; the
-/// dynamic gait's, `gait::force_difference_velocities`), as velocities of the feet (left, right): they move
-/// vertically against each other until their normal forces `forces` (N) split as the CoM
-/// set-point `com` asks, by the lever rule between the soles at `feet`. `gain`: m/s per N and
+/// dynamic gait's, `gait::force_difference_velocities`), as velocities of the feet (left,
+/// right): they move vertically against each other until their normal forces `forces` (N)
+/// split as the CoM set-point `com` asks, by the lever rule between the soles at `feet`. `gain`: m/s per N and
 /// the bound (m/s). A robot held stiffly by its joints rocks from one foot onto the other as a
 /// rigid block (an arm's reach, a shift of the CoM excite it); pressing the foot that lost its
 /// load back down damps that.
