@@ -381,6 +381,7 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         .map(|robot| Subject::load(args, robot))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let mut results = Vec::new();
+    let mut errors = Vec::new();
     for subject in &subjects {
         let robot = subject.robot;
         let runs = requests.iter().flat_map(|request| {
@@ -392,7 +393,14 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         for (i, (request, injection)) in runs.enumerate() {
             let pictured = args.snapshots.as_deref().filter(|_| i == 0);
             let run = (i, request);
-            let result = run_once(
+            let label = format!(
+                "{robot} {} {} m run {}{}",
+                request.affordances,
+                request.distance,
+                request.seed,
+                injection.map_or_else(String::new, |i| format!(" ({})", i.label()))
+            );
+            match run_once(
                 args,
                 &source,
                 subject,
@@ -400,36 +408,77 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
                 scene.as_ref(),
                 *injection,
                 pictured,
-            )
-            .with_context(|| {
-                format!(
-                    "{robot} {} {} m run {}{}",
-                    request.affordances,
-                    request.distance,
-                    request.seed,
-                    injection.map_or_else(String::new, |i| format!(" ({})", i.label()))
-                )
-            })?;
-            if !args.json {
-                eprintln!("{}", row(&result));
+            ) {
+                Ok(result) => {
+                    if !args.json {
+                        eprintln!("{}", row(&result));
+                    }
+                    results.push(result);
+                }
+                Err(error) => {
+                    let error = RunError {
+                        run: label,
+                        message: format!("{error:#}"),
+                    };
+                    eprintln!("{error}");
+                    errors.push(error);
+                }
             }
-            results.push(result);
         }
         if let Some(dir) = &args.plots {
             plot_robot(dir, robot, &results)?;
         }
     }
     if args.json {
-        let runs: Vec<_> = results.iter().map(RunResult::json).collect();
-        println!("{}", serde_json::json!({ "runs": runs }));
+        println!("{}", report_json(&results, &errors));
     } else {
         print!("{}", summary(&results));
+        for error in &errors {
+            println!("{error}");
+        }
     }
+    verdict(&results, &errors)
+}
+
+/// A run that could not be carried to its end (a process that did not start or stopped
+/// answering, a sequence that could not be generated): reported with the others, and the matrix
+/// goes on, so one bad run does not lose the results of a long evaluation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunError {
+    /// Which run: robot, affordance set, distance, run number and injected fault.
+    pub run: String,
+    /// The error with its causes.
+    pub message: String,
+}
+
+impl std::fmt::Display for RunError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "error: {}: {}", self.run, self.message)
+    }
+}
+
+/// The JSON report: every run carried out, and every run that errored.
+fn report_json(results: &[RunResult], errors: &[RunError]) -> serde_json::Value {
+    let runs: Vec<_> = results.iter().map(RunResult::json).collect();
+    let errors: Vec<_> = errors
+        .iter()
+        .map(|e| serde_json::json!({ "run": e.run, "error": e.message }))
+        .collect();
+    serde_json::json!({ "runs": runs, "errors": errors })
+}
+
+/// Success only when every run was carried out and succeeded.
+fn verdict(results: &[RunResult], errors: &[RunError]) -> anyhow::Result<()> {
     let failed = results.iter().filter(|r| !r.record.success).count();
-    if failed > 0 {
-        bail!("{failed} of {} runs did not succeed", results.len());
+    let total = results.len() + errors.len();
+    match (failed, errors.len()) {
+        (0, 0) => Ok(()),
+        (_, 0) => bail!("{failed} of {total} runs did not succeed"),
+        (_, errored) => bail!(
+            "{} of {total} runs did not succeed ({errored} of them errored before their end)",
+            failed + errored
+        ),
     }
-    Ok(())
 }
 
 /// Fig. 6 of `robot`'s first feet-only run (or its first run) into `dir`.
@@ -770,4 +819,34 @@ fn summary(results: &[RunResult]) -> String {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_errored_run_is_reported_and_fails_the_evaluation() {
+        let errors = [RunError {
+            run: "jvrc1 feet 5 m run 3".to_owned(),
+            message: "walkd did not get fresh samples within 30 s".to_owned(),
+        }];
+        let json = report_json(&[], &errors);
+        assert_eq!(json["runs"].as_array().map(Vec::len), Some(0));
+        assert_eq!(json["errors"][0]["run"], "jvrc1 feet 5 m run 3");
+        assert_eq!(
+            json["errors"][0]["error"],
+            "walkd did not get fresh samples within 30 s"
+        );
+        let verdict = verdict(&[], &errors).unwrap_err().to_string();
+        assert_eq!(
+            verdict,
+            "1 of 1 runs did not succeed (1 of them errored before their end)"
+        );
+        assert_eq!(
+            errors[0].to_string(),
+            "error: jvrc1 feet 5 m run 3: walkd did not get fresh samples within 30 s"
+        );
+        assert!(super::verdict(&[], &[]).is_ok());
+    }
 }

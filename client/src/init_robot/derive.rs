@@ -15,7 +15,10 @@
 //!   uniformly from JVRC-1 (not 0.16·r, which maps the stride onto 0.8 s_max·r);
 //! - `[postprocess.dynamic]`: `s_max` = 0.48 m·r·k, at most 4 l sin(ankle pitch room − margin)
 //!   (a foot a quarter stride behind the hip tilts the leg by asin(s_max / 4l), which the ankle
-//!   pitch has to follow: ARMAR-4's short steps); `scf` = 0.46 × (s_max / 0.48 m) × (P_ref / P);
+//!   pitch has to follow) and at most [`SWING_SWEEP_SHARE`] × ω l × `single_support_s`, with ω
+//!   the slowest leg joint's commanded speed limit (`velocity_limit_scale` × URDF velocity): the
+//!   swing foot crosses about two steps in single support, and a leg swept at ω moves its foot
+//!   at most ω l (ARMAR-4's short steps); `scf` = 0.46 × (s_max / 0.48 m) × (P_ref / P);
 //!   `h_min`, `h_max` = (0.02, 0.03) m·r; `alpha_y` 0.05 rad;
 //! - lateral foot distance: `o_min` = max(0.78 × hip width, sole width + 0.05 m), `o_max` =
 //!   max(1.25 × hip width, `o_min` + 0.02 m);
@@ -32,9 +35,13 @@
 //!   (the walking speed stays the Froude speed);
 //! - `[controller]`: JVRC-1's values but `max_step_m` = max(0.5 m·r, dynamic s_max + 0.02 m),
 //!   `lift_height_m`, `approach_height_m` ·r and `com_speed`, `swing_speed`, `lower_speed` ·t;
+//!   `torso_gain` at most the slowest torso joint's commanded speed limit over
+//!   [`TORSO_SATURATION_RAD`] (ARMAR-4's 0.4 rad/s torso pitch); roll-limited, ARMAR-4's bounds
+//!   on the pelvis tilt rate and the anchor correction, and a released hand left to the posture
+//!   (`carry_released_hands` off);
 //! - `[gait.dynamic.stabilizer]`: JVRC-1's switches and values but `foot_damping_gain` = 5e-4 ×
-//!   m_ref/m and `force_difference_gain` = 1e-5 × m_ref/m (the CoP torque and the force
-//!   difference grow with the weight);
+//!   m_ref/m (roll-limited: ARMAR-4's 2e-3 × m_ARMAR/m) and `force_difference_gain` = 1e-5 ×
+//!   m_ref/m (the CoP torque and the force difference grow with the weight);
 //! - `[gait]` `default = "static"`; `[runtime]` JVRC-1's with `service_prefix = "walk/<name>"`.
 
 use super::dimensions::RobotDimensions;
@@ -47,6 +54,15 @@ use super::reference::{self, GRAVITY, Tuned};
 pub const ROLL_SWAY_RATIO: f64 = 0.32;
 /// The step period is not shortened below this fraction of its Froude value.
 pub const MIN_PERIOD_FRACTION: f64 = 0.6;
+/// The longest dynamic step as a share of ω l T_ss, how far a leg swept at its slowest joint's
+/// commanded speed ω moves its foot in single support: ARMAR-4's hand-tuned 0.2 m step in 0.4 s
+/// at 0.5 × 1.71 rad/s with l = 0.834 m is 0.70 of it (the test `armar4_hand_tuned_swing_share`);
+/// its derived 0.33 m step (the ankle-pitch rule alone) tipped 59 of 60 MuJoCo walks.
+pub const SWING_SWEEP_SHARE: f64 = 0.70;
+/// The torso task's error (rad) at which its command reaches the slowest torso joint's commanded
+/// speed: ARMAR-4's torso pitch (0.5 × 0.4 rad/s) with its hand-tuned gain 1. At JVRC-1's gain
+/// 10 it saturated at 0.02 rad, and its static walks with a hand tipped.
+pub const TORSO_SATURATION_RAD: f64 = 0.2;
 
 /// One value of a derived section.
 #[derive(Debug, Clone, PartialEq)]
@@ -242,6 +258,7 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
     let pelvis = reference.pelvis_height_m / d.pelvis_height_m;
     let weight = reference.mass_kg / d.mass_kg;
     let margin = reference::number(&reference::CONTROLLER, "joint_limit_margin_rad");
+    let speed_scale = reference::number(&reference::CONTROLLER, "velocity_limit_scale");
     let l_is = format!("l = {l:.3} m");
     let lateral = lateral(d, t, margin);
     let k = lateral.period_fraction;
@@ -280,13 +297,28 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
     let pitch_cap = d
         .ankle_pitch_room_rad
         .map(|room| 4.0 * l * (room - margin).max(0.0).sin());
-    let s_max_dynamic = round(s_dyn_froude.min(pitch_cap.unwrap_or(f64::INFINITY)), 0.001);
-    let s_dyn_rule = match pitch_cap {
-        Some(cap) if cap < s_dyn_froude => format!(
+    let swing_speed = d.leg_velocity_min_rad_s.map(|v| speed_scale * v);
+    let sweep_cap = swing_speed.map(|omega| SWING_SWEEP_SHARE * omega * l * single);
+    let s_max_dynamic = round(
+        s_dyn_froude
+            .min(pitch_cap.unwrap_or(f64::INFINITY))
+            .min(sweep_cap.unwrap_or(f64::INFINITY)),
+        0.001,
+    );
+    let froude_rule = format!(
+        "0.48 m × l/l_ref{} = {s_dyn_froude:.3} m",
+        if k < 1.0 { " × k" } else { "" }
+    );
+    let s_dyn_rule = match (pitch_cap, sweep_cap) {
+        (_, Some(cap)) if cap < s_dyn_froude && pitch_cap.is_none_or(|p| cap <= p) => format!(
+            "{SWING_SWEEP_SHARE} ω l T_ss = {SWING_SWEEP_SHARE} × {:.3} × {l:.3} × {single}: the \
+             swing leg at its slowest joint's commanded speed ω ({froude_rule} is longer)",
+            swing_speed.unwrap_or_default()
+        ),
+        (Some(cap), _) if cap < s_dyn_froude => format!(
             "4 l sin(ankle pitch room − margin) = 4 × {l:.3} × sin({:.3} − {margin}): a foot \
-             s_max/4 behind the hip (0.48 m × l/l_ref{} = {s_dyn_froude:.3} m is longer)",
+             s_max/4 behind the hip ({froude_rule} is longer)",
             d.ankle_pitch_room_rad.unwrap_or_default(),
-            if k < 1.0 { " × k" } else { "" }
         ),
         _ if k < 1.0 => format!("0.48 m × l/l_ref × {k:.2} (the period's fraction), {l_is}"),
         _ => format!("0.48 m × l/l_ref, {l_is}"),
@@ -367,7 +399,26 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
         "JVRC-1's: shorter steps up and down stairs",
     ));
 
-    let controller = controller(r, t, max_step, s_max_dynamic);
+    let roll_limited = lateral.roll.is_some_and(|c| c.limited);
+    let torso_gain = d
+        .torso_velocity_min_rad_s
+        .map(|v| speed_scale * v / TORSO_SATURATION_RAD)
+        .filter(|&gain| gain < reference::number(&reference::CONTROLLER, "torso_gain"))
+        .map(|gain| {
+            (
+                significant(gain),
+                speed_scale * d.torso_velocity_min_rad_s.unwrap_or(0.0),
+            )
+        });
+    let controller = controller(
+        Scales { r, t },
+        ControllerRules {
+            max_step,
+            s_max_dynamic,
+            torso_gain,
+            roll_limited,
+        },
+    );
 
     let mut gait_dynamic = lateral.lines.clone();
     for (name, _) in reference::GAIT_DYNAMIC.iter() {
@@ -393,6 +444,16 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
     )];
     for (name, _) in reference::STABILIZER.iter() {
         stabilizer.push(match *name {
+            "foot_damping_gain" if roll_limited => Line::Key {
+                key: name,
+                value: Value::Exponent(significant(
+                    reference::armar4::FOOT_DAMPING_GAIN * reference::armar4::MASS_KG / d.mass_kg,
+                )),
+                rule: format!(
+                    "roll-limited: ARMAR-4's 2e-3 × m_ARMAR/m, m = {:.2} kg [rad/s per N·m]",
+                    d.mass_kg
+                ),
+            },
             "foot_damping_gain" => Line::Key {
                 key: name,
                 value: Value::Exponent(significant(5e-4 * weight)),
@@ -607,8 +668,29 @@ fn lateral(d: &RobotDimensions, t: f64, margin: f64) -> Lateral {
     result
 }
 
+/// The size ratios: r = l / l_ref and t = √r.
+struct Scales {
+    r: f64,
+    t: f64,
+}
+
+/// What `[controller]` takes from the other rules.
+struct ControllerRules {
+    max_step: f64,
+    s_max_dynamic: f64,
+    /// The torso gain and the torso's commanded speed limit, when that limit lowers the gain.
+    torso_gain: Option<(f64, f64)>,
+    roll_limited: bool,
+}
+
 /// `[controller]`: JVRC-1's, with the scaled lengths and speeds.
-fn controller(r: f64, t: f64, max_step: f64, s_max_dynamic: f64) -> Vec<Line> {
+fn controller(Scales { r, t }: Scales, rules: ControllerRules) -> Vec<Line> {
+    let ControllerRules {
+        max_step,
+        s_max_dynamic,
+        torso_gain,
+        roll_limited,
+    } = rules;
     let mut lines = vec![comment(
         "QP controller and stance state machine (daemon::controller; docs/controller.md). \
          Unknown keys are errors. JVRC-1's values; lengths scale with l/l_ref, speeds with \
@@ -638,8 +720,35 @@ fn controller(r: f64, t: f64, max_step: f64, s_max_dynamic: f64) -> Vec<Line> {
             ),
             "lift_height_m" | "approach_height_m" => scaled(r, "r"),
             "com_speed" | "swing_speed" | "lower_speed" => scaled(t, "t"),
+            "torso_gain" => match torso_gain {
+                Some((gain, speed)) => key(
+                    name,
+                    gain,
+                    format!(
+                        "the torso's commanded speed {speed:.3} rad/s at a \
+                         {TORSO_SATURATION_RAD} rad error (JVRC-1's 10 is faster)"
+                    ),
+                ),
+                None => kept(&reference::CONTROLLER, name, ""),
+            },
+            "carry_released_hands" if roll_limited => Line::Key {
+                key: name,
+                value: Value::Switch(reference::armar4::CARRY_RELEASED_HANDS),
+                rule: "roll-limited: ARMAR-4's; a released arm carried out to the side tipped its \
+                       static walks with a hand"
+                    .to_owned(),
+            },
             _ => kept(&reference::CONTROLLER, name, ""),
         });
+        if *name == "max_base_speed" && roll_limited {
+            for (bound, _) in &reference::armar4::ROLL_LIMITED_BOUNDS {
+                lines.push(kept(
+                    &reference::armar4::ROLL_LIMITED_BOUNDS,
+                    bound,
+                    "roll-limited: ARMAR-4's (docs/controller.md, \"Pelvis tilt rate\")",
+                ));
+            }
+        }
     }
     lines
 }
@@ -917,6 +1026,52 @@ mod tests {
     }
 
     #[test]
+    fn armar4_hand_tuned_swing_share() {
+        // configs/armar4.toml's dynamic step on its measured dimensions: s_max / (ω l T_ss).
+        let d = hand_tuned("armar4");
+        let file = config("armar4");
+        let get = |table, key| configured(&file, table, key).expect(key);
+        let omega = get("controller", "velocity_limit_scale") * d.leg_velocity_min_rad_s.unwrap();
+        let share = get("postprocess.dynamic", "s_max")
+            / (omega * d.leg_length_m * get("gait.dynamic", "single_support_s"));
+        assert!((share - SWING_SWEEP_SHARE).abs() < 0.005, "share {share}");
+        // The torso: 0.5 × 0.4 rad/s at 0.2 rad is the hand-tuned gain.
+        let torso = get("controller", "velocity_limit_scale") * d.torso_velocity_min_rad_s.unwrap()
+            / TORSO_SATURATION_RAD;
+        assert_eq!(torso, get("controller", "torso_gain"));
+    }
+
+    #[test]
+    fn armar4_reference_values_are_its_config() {
+        use reference::armar4;
+        let file = config("armar4");
+        let get = |table, key| configured(&file, table, key).expect(key);
+        assert_eq!(
+            get("gait.dynamic", "single_support_s"),
+            armar4::SINGLE_SUPPORT_S
+        );
+        assert_eq!(get("postprocess.dynamic", "s_max"), armar4::S_MAX_DYNAMIC);
+        assert_eq!(get("controller", "torso_gain"), armar4::TORSO_GAIN);
+        assert_eq!(
+            get("gait.dynamic.stabilizer", "foot_damping_gain"),
+            armar4::FOOT_DAMPING_GAIN
+        );
+        for (key, _) in armar4::ROLL_LIMITED_BOUNDS {
+            assert_eq!(
+                get("controller", key),
+                reference::number(&armar4::ROLL_LIMITED_BOUNDS, key),
+                "{key}"
+            );
+        }
+        let controller = daemon::controller::ControllerConfig::from_config(&file).unwrap();
+        assert_eq!(
+            controller.carry_released_hands,
+            armar4::CARRY_RELEASED_HANDS
+        );
+        assert!((hand_tuned("armar4").mass_kg - armar4::MASS_KG).abs() < 0.005);
+    }
+
+    #[test]
     fn armar4_is_roll_limited_with_an_inward_zmp_and_a_shorter_step() {
         let d = hand_tuned("armar4");
         let derived = derive(&d);
@@ -951,6 +1106,63 @@ mod tests {
         assert_eq!(s.o_dynamic, (0.17, 0.18));
         assert_eq!(derived.number("postprocess.dynamic", "alpha_x"), Some(0.01));
         assert!(!derived.notes.is_empty());
+        // ARMAR-4's own bounds, damping and torso gain.
+        let file = config("armar4");
+        for (table, key) in [
+            ("controller", "max_base_tilt_speed"),
+            ("controller", "max_anchor_correction_speed"),
+            ("controller", "max_anchor_correction_angular_speed"),
+            ("controller", "torso_gain"),
+            ("gait.dynamic.stabilizer", "foot_damping_gain"),
+        ] {
+            assert_eq!(
+                derived.number(table, key),
+                configured(&file, table, key),
+                "[{table}] {key}"
+            );
+        }
+        assert!(
+            derived
+                .sections
+                .iter()
+                .flat_map(|s| &s.lines)
+                .any(|line| matches!(
+                    line,
+                    Line::Key {
+                        key: "carry_released_hands",
+                        value: Value::Switch(false),
+                        ..
+                    }
+                ))
+        );
+    }
+
+    #[test]
+    fn slow_legs_shorten_the_dynamic_step() {
+        // JVRC-1 with ARMAR-4's 1.71 rad/s legs: 0.70 × 0.855 rad/s × 0.823 m × 0.55 s.
+        let mut d = reference::jvrc1();
+        d.leg_velocity_min_rad_s = Some(1.7104);
+        let derived = derive(&d);
+        let want = round(
+            SWING_SWEEP_SHARE * 0.5 * 1.7104 * d.leg_length_m * 0.55,
+            0.001,
+        );
+        assert_eq!(derived.summary.s_max_dynamic, want);
+        assert!(want < 0.3, "{want}");
+        // Without a known limit, JVRC-1's step.
+        d.leg_velocity_min_rad_s = None;
+        assert_eq!(derive(&d).summary.s_max_dynamic, 0.48);
+    }
+
+    #[test]
+    fn a_slow_torso_lowers_the_torso_gain() {
+        let mut d = reference::jvrc1();
+        d.torso_velocity_min_rad_s = Some(1.0);
+        assert_eq!(derive(&d).number("controller", "torso_gain"), Some(2.5));
+        for fast in [None, Some(50_000.0)] {
+            d.torso_velocity_min_rad_s = fast;
+            assert_eq!(derive(&d).number("controller", "torso_gain"), Some(10.0));
+        }
     }
 
     #[test]

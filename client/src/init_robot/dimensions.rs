@@ -18,6 +18,7 @@
 //! ankle_pitch_room_rad = 0.8     # optional: ankle pitch's room towards further bending
 //! leg_effort_min_nm = 40.0       # optional: smallest leg joint effort limit
 //! leg_velocity_min_rad_s = 5.0   # optional: smallest leg joint velocity limit
+//! torso_velocity_min_rad_s = 2.0 # optional: smallest torso joint velocity limit
 //! ```
 
 use std::path::Path;
@@ -59,9 +60,14 @@ pub struct RobotDimensions {
     /// Smallest effort limit of the leg joints (N·m); reported, no rule uses it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub leg_effort_min_nm: Option<f64>,
-    /// Smallest velocity limit of the leg joints (rad/s); reported, no rule uses it.
+    /// Smallest velocity limit of the leg joints (rad/s): it bounds how fast a swing leg sweeps
+    /// its foot forward, so the dynamic step; absent: not known (then it limits nothing).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub leg_velocity_min_rad_s: Option<f64>,
+    /// Smallest velocity limit of the torso joints (rad/s): it bounds the torso task's gain;
+    /// absent: no torso joint, or not known (then it limits nothing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torso_velocity_min_rad_s: Option<f64>,
 }
 
 impl RobotDimensions {
@@ -80,6 +86,7 @@ impl RobotDimensions {
             ("ankle_pitch_room_rad", self.ankle_pitch_room_rad),
             ("leg_effort_min_nm", self.leg_effort_min_nm),
             ("leg_velocity_min_rad_s", self.leg_velocity_min_rad_s),
+            ("torso_velocity_min_rad_s", self.torso_velocity_min_rad_s),
         ]
     }
 
@@ -169,6 +176,7 @@ fn describe(key: &str) -> &'static str {
         "ankle_pitch_room_rad" => "ankle pitch range from standing towards further bending [rad]",
         "leg_effort_min_nm" => "smallest leg joint effort limit [N·m]",
         "leg_velocity_min_rad_s" => "smallest leg joint velocity limit [rad/s]",
+        "torso_velocity_min_rad_s" => "smallest torso joint velocity limit [rad/s]",
         _ => "",
     }
 }

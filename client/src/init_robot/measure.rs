@@ -10,7 +10,7 @@
 //! - ankle roll range: over both legs, the smaller distance from the standing angle to a limit;
 //! - ankle pitch room: over both legs, the distance from the standing angle to the limit on the
 //!   side it already leans to (the side a foot left behind the hip turns it further);
-//! - the legs' smallest effort and velocity limits.
+//! - the legs' smallest effort and velocity limits, the torso joints' smallest velocity limit.
 
 use kinematics::{EndEffector, Kinematics, Robot, Vector3};
 
@@ -79,6 +79,15 @@ pub fn measure(robot: &Robot, urdf: &UrdfModel, legs: &Legs) -> RobotDimensions 
             .filter(|e| e.is_finite()),
         leg_velocity_min_rad_s: min_over(leg_joints.iter().map(|&j| limits[j].velocity).collect())
             .filter(|v| v.is_finite()),
+        torso_velocity_min_rad_s: min_over(
+            robot
+                .joint_groups
+                .torso
+                .iter()
+                .map(|&j| limits[j].velocity)
+                .collect(),
+        )
+        .filter(|v| v.is_finite()),
     }
 }
 
@@ -130,5 +139,8 @@ pub(crate) mod tests {
         assert!((d.ankle_roll_range_rad.unwrap() - 0.06).abs() < 1e-4);
         assert!((d.ankle_pitch_room_rad.unwrap() - (0.4906 - 0.4064)).abs() < 1e-3);
         assert!(d.com_height_m > d.leg_length_m && d.leg_length_m > 0.8);
+        // Slow joints: 1.71 rad/s in the legs, 0.4 rad/s at the torso pitch.
+        assert!((d.leg_velocity_min_rad_s.unwrap() - 1.7104).abs() < 1e-4);
+        assert_eq!(d.torso_velocity_min_rad_s, Some(0.4));
     }
 }

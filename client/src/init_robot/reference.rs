@@ -24,6 +24,7 @@ pub fn jvrc1() -> RobotDimensions {
         ankle_pitch_room_rad: Some(1.1035),
         leg_effort_min_nm: Some(100.0),
         leg_velocity_min_rad_s: Some(8.9012),
+        torso_velocity_min_rad_s: Some(8.9012),
     }
 }
 
@@ -147,6 +148,34 @@ pub mod dynamic {
     pub const ALPHA_Y: f64 = 0.05;
     /// `rise_weight`.
     pub const RISE_WEIGHT: f64 = 3.5;
+}
+
+/// ARMAR-4's hand-tuned values (`configs/armar4.toml`) that calibrate the rules for a robot
+/// with little ankle roll or slow joints, which JVRC-1 cannot calibrate. A test checks them
+/// against the file.
+pub mod armar4 {
+    use super::Tuned;
+
+    /// Total mass (kg), measured from its model.
+    pub const MASS_KG: f64 = 72.04;
+    /// `[gait.dynamic]` `single_support_s`.
+    pub const SINGLE_SUPPORT_S: f64 = 0.4;
+    /// `[postprocess.dynamic]` `s_max` (m).
+    pub const S_MAX_DYNAMIC: f64 = 0.2;
+    /// `[controller]` `torso_gain` (1/s).
+    pub const TORSO_GAIN: f64 = 1.0;
+    /// `[gait.dynamic.stabilizer]` `foot_damping_gain` (rad/s per N·m).
+    pub const FOOT_DAMPING_GAIN: f64 = 2e-3;
+    /// `[controller]` bounds of a robot that sways on its pelvis because its ankle roll is
+    /// small (docs/controller.md, "Pelvis tilt rate").
+    pub const ROLL_LIMITED_BOUNDS: [(&str, Tuned); 3] = [
+        ("max_base_tilt_speed", Tuned::Number(0.2)),
+        ("max_anchor_correction_speed", Tuned::Number(0.01)),
+        ("max_anchor_correction_angular_speed", Tuned::Number(0.1)),
+    ];
+    /// `[controller]` `carry_released_hands` (absent from its config: the default): with heavy
+    /// arms and little ankle roll it cannot balance with a released arm carried out to the side.
+    pub const CARRY_RELEASED_HANDS: bool = false;
 }
 
 /// The value of `key` in one of the tables above.

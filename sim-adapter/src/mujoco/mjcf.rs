@@ -15,7 +15,9 @@
 //!   terrain only;
 //! - sites at every end-effector frame, the four FT frames (ankles and wrists) and the base (the
 //!   IMU);
-//! - per joint a position and a velocity actuator (the servo), in model joint order;
+//! - per joint a position and a velocity actuator (the servo), in model joint order; a joint
+//!   weaker than [`SERVO_REFERENCE_EFFORT_NM`] has its gains and armature scaled down
+//!   ([`servo_scale`]);
 //! - IMU sensors (orientation, gyro, accelerometer) at the base site;
 //! - with `visual_geoms`, what pictures need and the physics ignores ([`visuals`](super::visuals)):
 //!   visual-only geoms of the links in geom group [`VISUAL_GROUP`](super::visuals::VISUAL_GROUP)
@@ -46,6 +48,25 @@ use super::bodies::{MassProperties, RigidBodies};
 use super::options::MujocoOptions;
 use super::terrain::Terrain;
 use super::visuals::{self, VisualGeom};
+
+/// The motor torque (N·m) the default servo gains and armature were tuned for: JVRC-1's URDF
+/// effort on every joint. See [`servo_scale`].
+pub const SERVO_REFERENCE_EFFORT_NM: f64 = 100.0;
+
+/// The factor on a joint's servo gains and armature: its effort limit over
+/// [`SERVO_REFERENCE_EFFORT_NM`], at most 1 (1 without a limit). At the default gains a 100 N·m
+/// joint saturates at 1 mrad of position error and 0.1 rad/s of velocity error; a weaker joint
+/// would saturate earlier and act as a bang-bang controller: iCub's 37 N·m knees and ankles
+/// chattered standing still (foot forces jumping between 0 and 931 N under a 324 N robot).
+/// Scaled, every joint saturates no earlier than a 100 N·m one, and the servo's stability margin
+/// kp·h²/armature is unchanged. Stronger joints keep the default, bit for bit.
+pub fn servo_scale(effort: f64) -> f64 {
+    if effort.is_finite() && effort > 0.0 {
+        (effort / SERVO_REFERENCE_EFFORT_NM).min(1.0)
+    } else {
+        1.0
+    }
+}
 
 /// Name of the floating base's free joint.
 pub(crate) const FREE_JOINT: &str = "floating_base";
@@ -158,17 +179,19 @@ pub(crate) fn write(
     write_body(&mut xml, robot, bodies, &attachments, o, 0, 2);
     let _ = writeln!(xml, "  </worldbody>");
     let _ = writeln!(xml, "  <actuator>");
-    for joint in robot.model.joint_names() {
+    let limits = robot.model.joint_limits();
+    for (joint, limits) in robot.model.joint_names().iter().zip(limits) {
         let name = escape(joint);
+        let scale = servo_scale(limits.effort);
         let _ = writeln!(
             xml,
             r#"    <position joint="{name}" kp="{}"/>"#,
-            o.servo_stiffness
+            o.servo_stiffness * scale
         );
         let _ = writeln!(
             xml,
             r#"    <velocity joint="{name}" kv="{}"/>"#,
-            o.servo_damping
+            o.servo_damping * scale
         );
     }
     let _ = writeln!(xml, "  </actuator>");
@@ -383,10 +406,18 @@ fn write_body(
             } else {
                 String::new()
             };
+            // A weaker motor's rotor: the armature scales with the servo (below), so the
+            // servo's stability margin kp·h²/armature is the same on every joint.
+            let scale = servo_scale(limits.effort);
+            let armature = if scale < 1.0 {
+                format!(r#" armature="{}""#, options.armature * scale)
+            } else {
+                String::new()
+            };
             let a = joint.axis;
             let _ = writeln!(
                 xml,
-                r#"{pad}  <joint name="{}" type="{kind}" axis="{} {} {}"{range}{effort}/>"#,
+                r#"{pad}  <joint name="{}" type="{kind}" axis="{} {} {}"{range}{effort}{armature}/>"#,
                 escape(&joint.name),
                 a.x,
                 a.y,
