@@ -57,7 +57,7 @@ pub const MIN_PERIOD_FRACTION: f64 = 0.6;
 /// The longest dynamic step as a share of ω l T_ss, how far a leg swept at its slowest joint's
 /// commanded speed ω moves its foot in single support: ARMAR-4's hand-tuned 0.2 m step in 0.4 s
 /// at 0.5 × 1.71 rad/s with l = 0.834 m is 0.70 of it (the test `armar4_hand_tuned_swing_share`);
-/// its derived 0.33 m step (the ankle-pitch rule alone) tipped 59 of 60 MuJoCo walks.
+/// its derived 0.33 m step (the ankle-pitch rule alone) walked 3 of 60 MuJoCo walks.
 pub const SWING_SWEEP_SHARE: f64 = 0.70;
 /// The torso task's error (rad) at which its command reaches the slowest torso joint's commanded
 /// speed: ARMAR-4's torso pitch (0.5 × 0.4 rad/s) with its hand-tuned gain 1. At JVRC-1's gain
@@ -402,14 +402,9 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
     let roll_limited = lateral.roll.is_some_and(|c| c.limited);
     let torso_gain = d
         .torso_velocity_min_rad_s
-        .map(|v| speed_scale * v / TORSO_SATURATION_RAD)
-        .filter(|&gain| gain < reference::number(&reference::CONTROLLER, "torso_gain"))
-        .map(|gain| {
-            (
-                significant(gain),
-                speed_scale * d.torso_velocity_min_rad_s.unwrap_or(0.0),
-            )
-        });
+        .map(|v| speed_scale * v)
+        .map(|speed| (significant(speed / TORSO_SATURATION_RAD), speed))
+        .filter(|&(gain, _)| gain < reference::number(&reference::CONTROLLER, "torso_gain"));
     let controller = controller(
         Scales { r, t },
         ControllerRules {

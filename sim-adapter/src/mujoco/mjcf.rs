@@ -39,7 +39,7 @@
 
 use std::fmt::Write;
 
-use kinematics::model::{FrameId, Model};
+use kinematics::model::{FrameId, JointLimits, Model};
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Translation3, Vector3};
 
@@ -57,15 +57,17 @@ pub const SERVO_REFERENCE_EFFORT_NM: f64 = 100.0;
 /// [`SERVO_REFERENCE_EFFORT_NM`], at most 1 (1 without a limit). At the default gains a 100 N·m
 /// joint saturates at 1 mrad of position error and 0.1 rad/s of velocity error; a weaker joint
 /// would saturate earlier and act as a bang-bang controller: iCub's 37 N·m knees and ankles
-/// chattered standing still (foot forces jumping between 0 and 931 N under a 324 N robot).
-/// Scaled, every joint saturates no earlier than a 100 N·m one, and the servo's stability margin
-/// kp·h²/armature is unchanged. Stronger joints keep the default, bit for bit.
-pub fn servo_scale(effort: f64) -> f64 {
-    if effort.is_finite() && effort > 0.0 {
-        (effort / SERVO_REFERENCE_EFFORT_NM).min(1.0)
-    } else {
-        1.0
-    }
+/// chattered under walkd's closed loop in their first double support (foot forces jumping
+/// between 0 and 931 N under a 324 N robot). Scaled, every joint saturates no earlier than a
+/// 100 N·m one, and the servo's stability margin kp·h²/armature is unchanged. Stronger joints
+/// keep the default, bit for bit.
+pub fn servo_scale(limits: &JointLimits) -> f64 {
+    effort_bound(limits).map_or(1.0, |effort| (effort / SERVO_REFERENCE_EFFORT_NM).min(1.0))
+}
+
+/// The joint's motor torque bound: its URDF effort, unless that is 0 or absent (unbounded).
+fn effort_bound(limits: &JointLimits) -> Option<f64> {
+    Some(limits.effort).filter(|effort| effort.is_finite() && *effort > 0.0)
 }
 
 /// Name of the floating base's free joint.
@@ -182,7 +184,7 @@ pub(crate) fn write(
     let limits = robot.model.joint_limits();
     for (joint, limits) in robot.model.joint_names().iter().zip(limits) {
         let name = escape(joint);
-        let scale = servo_scale(limits.effort);
+        let scale = servo_scale(limits);
         let _ = writeln!(
             xml,
             r#"    <position joint="{name}" kp="{}"/>"#,
@@ -398,17 +400,15 @@ fn write_body(
             };
             // The motor's torque saturation: MuJoCo clamps the sum of the joint's actuators
             // (the servo's position and velocity terms) to the URDF effort limit.
-            let effort = if limits.effort.is_finite() && limits.effort > 0.0 {
+            let effort = effort_bound(limits).map_or_else(String::new, |effort| {
                 format!(
                     r#" actuatorfrclimited="true" actuatorfrcrange="{} {}""#,
-                    -limits.effort, limits.effort
+                    -effort, effort
                 )
-            } else {
-                String::new()
-            };
-            // A weaker motor's rotor: the armature scales with the servo (below), so the
-            // servo's stability margin kp·h²/armature is the same on every joint.
-            let scale = servo_scale(limits.effort);
+            });
+            // A weaker motor's rotor: the armature scales with the servo's gains (the
+            // actuators), so the stability margin kp·h²/armature is the same on every joint.
+            let scale = servo_scale(limits);
             let armature = if scale < 1.0 {
                 format!(r#" armature="{}""#, options.armature * scale)
             } else {
