@@ -139,9 +139,23 @@ fn check_invariants(
             e
         );
     }
-    // Every step ≤ s_max.
-    for step in steps(&poses, &path) {
+    // Every step ≤ s_max; the first one lands at most s_max / 2 ahead of (or behind) the other foot.
+    let steps = steps(&poses, &path);
+    for step in &steps {
         prop_assert!(step.length.abs() <= params.s_max + EPS, "{:?}", step);
+    }
+    if let Some(first) = steps.iter().min_by_key(|step| step.landing) {
+        let along = |foot| path.along(&poses.pose(first.landing, foot).translation.vector);
+        let other = if first.foot == FEET[0] {
+            FEET[1]
+        } else {
+            FEET[0]
+        };
+        let lead = along(first.foot) - along(other);
+        prop_assert!(
+            lead.abs() <= params.s_max / 2.0 + EPS,
+            "{first:?} leads by {lead}"
+        );
     }
     // Lateral distance within [o_min, o_max].
     for (i, o) in orthogonal_distances(&poses, &path).into_iter().enumerate() {

@@ -5,22 +5,27 @@ use kinematics::robot::EndEffector;
 use nalgebra::Vector3;
 
 use crate::environment::Environment;
-use crate::poses::{HANDS, PoseSequence};
+use crate::poses::{FEET, HANDS, PoseSequence};
 
 /// Not in Algorithm 1: puts each held hand on the railing it holds. For every contact run of a
-/// hand, the run's first target position is taken to the nearest point of the nearest hand
-/// affordance on that hand's side ([`crate::HandAffordance::is_on_the_side_of`],
-/// [`crate::HandAffordance::nearest_on_axis`]), raised along world +z by the affordance's radius
-/// plus `palm_radius`: the palm sphere (the hand's collision geometry, centred on the hand frame)
-/// rests on top of the rail and presses down on it. Every stance of the run gets that position
-/// (the hand does not slide while it holds); orientations and free hands are left as they are,
-/// and so is a hand with no affordance on its side (`RawSequence::in_environment` refuses such a
-/// walk in a scene).
+/// hand, the hand grasps the nearest hand affordance on its side
+/// ([`crate::HandAffordance::is_on_the_side_of`]) at its axis point nearest to where the hand
+/// reaches from ([`crate::HandAffordance::nearest_on_axis`]): abeam the feet it stands on
+/// through the run (the mean position of the soles in contact over the run's stances, at the
+/// height of the run's first hand target). The grasp is raised along world +z by the
+/// affordance's radius plus `palm_radius`: the palm sphere (the hand's collision geometry,
+/// centred on the hand frame) rests on top of the rail and presses down on it. Every stance of
+/// the run gets that position (the hand does not slide while it holds); orientations and free
+/// hands are left as they are, and so is a hand with no affordance on its side
+/// (`RawSequence::in_environment` refuses such a walk in a scene).
 ///
 /// The stance source's grasp is only where the hand reaches for: a scene's railing is elsewhere
 /// (its own height, its own distance from the path), and even on the source's own railing
-/// (radius 0) the grasp is the axis itself, where the palm would sit inside the rail. Runs after
-/// the terrain pass, so on terrain it starts from the final elevations. Allocation-free.
+/// (radius 0) the grasp is the axis itself, where the palm would sit inside the rail. Along the
+/// path the source's grasp is where the retargeted human hand was, moved by the passes' scaling
+/// and step shifts (0.02 m ahead to 0.10 m behind the run's feet on generated walks); abeam of
+/// the feet the arm reaches it from every stance of the run alike. Runs after the terrain pass,
+/// so on terrain it starts from the final elevations. Allocation-free.
 pub fn hold_hand_affordances(
     poses: &mut PoseSequence,
     environment: &Environment,
@@ -31,13 +36,31 @@ pub fn hold_hand_affordances(
         let mut grasp = None;
         for i in 0..poses.len() {
             if poses.contact_starts(i, hand) {
-                let from = poses.pose(i, hand).translation.vector;
+                let mut from = mean_support(poses, hand, i);
+                from.z = poses.pose(i, hand).translation.z;
                 grasp = on_top(environment, hand, &from, palm_radius);
             }
             if let (true, Some(grasp)) = (poses.in_contact(i, hand), grasp) {
                 poses.end_effectors[i][hand as usize].translation.vector = grasp;
             }
         }
+    }
+}
+
+/// Mean position of the soles in contact over the contact run of `hand` that starts in stance
+/// `start`.
+fn mean_support(poses: &PoseSequence, hand: EndEffector, start: usize) -> Vector3<f64> {
+    let (sum, count) = (start..poses.len())
+        .take_while(|&i| poses.in_contact(i, hand))
+        .flat_map(|i| FEET.iter().map(move |&foot| (i, foot)))
+        .filter(|&(i, foot)| poses.in_contact(i, foot))
+        .fold((Vector3::zeros(), 0.0), |(sum, n), (i, foot)| {
+            (sum + poses.pose(i, foot).translation.vector, n + 1.0)
+        });
+    if count == 0.0 {
+        poses.pose(start, hand).translation.vector
+    } else {
+        sum / count
     }
 }
 
@@ -118,14 +141,32 @@ mod tests {
             "{placed}"
         );
         // Past the railing's end: its end point.
+        let mut short = railing("right", -0.45);
+        short.start.x = 0.5;
         let mut far = held_walk();
-        far.translate(1, RightHand, &Vector3::new(-2.0, 0.0, 0.0));
-        hold_hand_affordances(&mut far, &env, PALM);
+        hold_hand_affordances(&mut far, &with_railings(vec![short]), PALM);
         let placed = far.pose(1, RightHand).translation.vector;
         assert!(
-            (placed - Vector3::new(-1.0, -0.45, 0.86)).norm() < 1e-12,
+            (placed - Vector3::new(0.5, -0.45, 0.86)).norm() < 1e-12,
             "{placed}"
         );
+    }
+
+    #[test]
+    fn a_hand_grasps_abeam_of_the_feet_it_stands_on() {
+        // The source's hand reached 0.3 m ahead of the feet and 0.1 m low; the run's soles stand
+        // at x = 0 throughout, so it grasps the railing beside them, at its own height.
+        let mut p = held_walk();
+        p.translate(1, RightHand, &Vector3::new(0.3, 0.0, -0.1));
+        p.translate(2, RightHand, &Vector3::new(0.3, 0.0, -0.1));
+        hold_hand_affordances(&mut p, &with_railings(vec![railing("right", -0.45)]), PALM);
+        for i in [1, 2] {
+            let placed = p.pose(i, RightHand).translation.vector;
+            assert!(
+                (placed - Vector3::new(0.0, -0.45, 0.86)).norm() < 1e-12,
+                "{i}: {placed}"
+            );
+        }
     }
 
     #[test]

@@ -118,8 +118,10 @@ fn flat_ground() -> &'static Environment {
     &FLAT
 }
 
-/// The walking path of a pose sequence (see [`PathFrame`]): from the first root along the mean
-/// heading of every contact foot pose; `None` when empty.
+/// The walking path of a pose sequence (see [`PathFrame`]): from the first root along the
+/// root's travel to the last stance, or along the mean heading of every contact foot pose when
+/// the root does not travel forward along it (standing, stepping in place, walking backwards);
+/// `None` when empty.
 pub fn path_of(poses: &PoseSequence) -> Option<PathFrame> {
     let origin = poses.roots.first()?.translation.vector;
     let contact_feet = (0..poses.len()).flat_map(|i| {
@@ -127,7 +129,13 @@ pub fn path_of(poses: &PoseSequence) -> Option<PathFrame> {
             .filter(move |&&foot| poses.in_contact(i, foot))
             .map(move |&foot| poses.pose(i, foot))
     });
-    Some(PathFrame::of_walk(&origin, contact_feet))
+    let heading = PathFrame::of_walk(&origin, contact_feet);
+    let travel = poses.roots.last()?.translation.vector - origin;
+    Some(
+        PathFrame::new(&origin, &travel)
+            .filter(|path| path.direction().dot(heading.direction()) > 0.0)
+            .unwrap_or(heading),
+    )
 }
 
 /// The sizes of the robot's contact geometry that the passes need: a foot's sole fits on its

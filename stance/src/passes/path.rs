@@ -34,11 +34,21 @@ fn next_contact(poses: &PoseSequence, e: EndEffector, from: usize) -> Option<usi
     (from..poses.len()).find(|&i| poses.in_contact(i, e))
 }
 
+/// How far the walk's first step may land ahead of (or behind) the standing foot, as a share of
+/// `s_max`: half, the lead of every later step of a walk whose strides are `s_max`.
+const FIRST_STEP_LEAD_SHARE: f64 = 0.5;
+
 /// Pass 7, `limitToMaxStepSize(s_max)`: shortens every step still longer than `s_max` (the
 /// along-path distance between consecutive contacts of one foot; backward steps alike) to
 /// exactly `s_max`. Everything after a shortened step moves back with it (see
 /// `shift_landings`): the landing and all later contact runs, the roots and free
 /// end-effectors of later stances. The covered distance shrinks.
+///
+/// Not in the paper: the walk's first step also lands at most `FIRST_STEP_LEAD_SHARE` (½) ×
+/// `s_max` ahead of the other foot. From standing, feet side by side, a step of `s_max` puts
+/// the foot a whole stride ahead, twice the lead of every later step (each foot then travels a
+/// stride to land half a stride ahead), and the dynamic gait's ZMP would jump that far in the
+/// double support after it. People start with a shorter step too.
 pub fn limit_to_max_step_size(poses: &mut PoseSequence, path: &PathFrame, s_max: f64) {
     shift_landings(
         poses,
@@ -46,27 +56,41 @@ pub fn limit_to_max_step_size(poses: &mut PoseSequence, path: &PathFrame, s_max:
         &mut StepLimit {
             s_max,
             last_contact_along: [None; 2],
+            stepped: false,
         },
     );
 }
 
-/// Pass 7's landing rule: a landing moves back by the part of its step beyond `s_max`.
+/// Pass 7's landing rule: a landing moves back by the part of its step beyond `s_max` (and the
+/// first step by the part of its lead beyond half of it).
 struct StepLimit {
     s_max: f64,
     /// Shifted along-path position of each foot's last contact.
     last_contact_along: [Option<f64>; 2],
+    /// Whether a foot has stepped yet (landed after a contact of its own).
+    stepped: bool,
 }
 
 impl LandingRule for StepLimit {
     type Placed = ();
 
     fn place(&self, f: usize, along: f64, _sole: &Isometry3<f64>) -> (f64, ()) {
-        let correction =
-            self.last_contact_along[f].map_or(0.0, |previous| excess(along - previous, self.s_max));
+        let Some(previous) = self.last_contact_along[f] else {
+            return (0.0, ());
+        };
+        let step = excess(along - previous, self.s_max);
+        let lead = match self.last_contact_along[1 - f] {
+            Some(other) if !self.stepped => {
+                excess(along - other, FIRST_STEP_LEAD_SHARE * self.s_max)
+            }
+            _ => 0.0,
+        };
+        let correction = if lead.abs() > step.abs() { lead } else { step };
         (-correction, ())
     }
 
     fn landed(&mut self, f: usize, along: f64, _placed: ()) {
+        self.stepped |= self.last_contact_along[f].is_some();
         self.last_contact_along[f] = Some(along);
     }
 }
@@ -297,15 +321,17 @@ mod tests {
     fn long_step_is_shortened_and_later_stances_follow() {
         let mut p = gait(0.6, 1.2);
         limit_to_max_step_size(&mut p, &x_path(), 0.4);
-        let s = steps(&p, &x_path());
-        assert_eq!(s.len(), 2);
+        let mut s = steps(&p, &x_path());
+        s.sort_by_key(|step| step.landing);
+        let lengths: Vec<f64> = s.iter().map(|step| step.length).collect();
+        // The first step from standing leads by half of s_max, the next one is s_max long.
         assert!(
-            s.iter().all(|step| (step.length - 0.4).abs() < 1e-12),
-            "{s:?}"
+            (lengths[0] - 0.2).abs() < 1e-12 && (lengths[1] - 0.4).abs() < 1e-12,
+            "{lengths:?}"
         );
         assert!((p.pose(4, LeftFoot).translation.x - 0.4).abs() < 1e-12);
         // The swing foot lies between its lift-off and landing.
-        assert!((p.pose(1, RightFoot).translation.x - 0.2).abs() < 1e-12);
+        assert!((p.pose(1, RightFoot).translation.x - 0.1).abs() < 1e-12);
         assert_eq!(
             p.pose(3, RightFoot),
             p.pose(2, RightFoot),
@@ -314,11 +340,30 @@ mod tests {
     }
 
     #[test]
-    fn step_exactly_at_s_max_is_untouched() {
-        let mut p = gait(0.4, 0.4);
+    fn steps_exactly_at_their_limits_are_untouched() {
+        // The first step leads by exactly half of s_max, the second is exactly s_max long.
+        let mut p = gait(0.2, 0.4);
         let before = p.clone();
         limit_to_max_step_size(&mut p, &x_path(), 0.4);
         assert_eq!(p, before);
+    }
+
+    #[test]
+    fn only_the_first_step_is_held_to_half_a_stride() {
+        // The second step leads the standing foot by 0.3 m, more than half of s_max, within it.
+        let mut p = gait(0.1, 0.4);
+        let before = p.clone();
+        limit_to_max_step_size(&mut p, &x_path(), 0.4);
+        assert_eq!(p, before);
+        // From staggered feet the first step may be s_max long (0.4 m), landing 0.2 m ahead.
+        let mut staggered = walk(&[
+            stance([0.2, 0.1, 0.0], [0.0, -0.1, 0.0], BOTH),
+            stance([0.2, 0.1, 0.0], [0.2, -0.1, 0.1], LEFT),
+            stance([0.2, 0.1, 0.0], [0.4, -0.1, 0.0], BOTH),
+        ]);
+        let before = staggered.clone();
+        limit_to_max_step_size(&mut staggered, &x_path(), 0.4);
+        assert_eq!(staggered, before);
     }
 
     #[test]
