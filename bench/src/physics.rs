@@ -6,7 +6,8 @@
 //! 500 Hz) with the servos tracking the command. A walk succeeds when the controller reaches
 //! `Done` and the simulated robot never fell (base height and torso tilt,
 //! [`MujocoSim::has_fallen`]) — neither during the walk nor while holding the final posture for
-//! [`PhysicsWalkOptions::settle_s`] afterwards.
+//! [`PhysicsWalkOptions::settle_s`] afterwards. A walk that faults is held as long and watched
+//! the same way: a fault the controller detected must not become a fall.
 //!
 //! Besides the outcome it measures what the paper's evaluation reports: simulated and wall time,
 //! the final position error of the feet, the drift between the controller's estimate and the
@@ -48,7 +49,8 @@ pub struct PhysicsWalkOptions {
     /// Simulated time after which an unfinished walk is stopped; `None`: 60 s + 20 s per stance
     /// (as `walkd bench`).
     pub time_limit_s: Option<f64>,
-    /// Simulated time the final posture is held after `Done` while still checking for a fall (s).
+    /// Simulated time the final posture (or a fault's hold) is held after `Done` (or the fault)
+    /// while still checking for a fall (s).
     pub settle_s: f64,
     /// Every this many ticks one [`TraceSample`] is recorded (0: no trace).
     pub trace_every: u64,
@@ -113,6 +115,9 @@ pub enum PhysicsOutcome {
     Fell {
         /// Simulated time of the fall (s).
         at_s: f64,
+        /// The fault the controller detected before the fall, holding since: a fault it
+        /// detected that still became a fall.
+        after: Option<FaultCode>,
     },
     /// The controller faulted.
     Fault(FaultCode),
@@ -130,7 +135,10 @@ impl PhysicsOutcome {
     pub fn label(&self) -> String {
         match self {
             Self::Done => "done".to_owned(),
-            Self::Fell { .. } => "fell".to_owned(),
+            Self::Fell { after: None, .. } => "fell".to_owned(),
+            Self::Fell {
+                after: Some(code), ..
+            } => format!("fell after fault:{}", code.code()),
             Self::Fault(code) => format!("fault:{}", code.code()),
             Self::TimeLimit => "time_limit".to_owned(),
             Self::Unstable { .. } => "unstable".to_owned(),
@@ -391,7 +399,10 @@ pub fn walk_sequence(
             });
         }
         if sim.has_fallen() {
-            break PhysicsOutcome::Fell { at_s: sim.time() };
+            break PhysicsOutcome::Fell {
+                at_s: sim.time(),
+                after: None,
+            };
         }
         match status.state {
             ControllerState::Done => break PhysicsOutcome::Done,
@@ -400,7 +411,13 @@ pub fn walk_sequence(
         }
     };
     let sim_s = closed.sim.time();
-    if outcome == PhysicsOutcome::Done {
+    // After `Done` the robot holds its last posture, after a fault the command it holds in: in
+    // both it must stand (a detected fault must not become a fall).
+    let fault = match outcome {
+        PhysicsOutcome::Fault(code) => Some(code),
+        _ => None,
+    };
+    if outcome == PhysicsOutcome::Done || fault.is_some() {
         for _ in 0..settle_ticks {
             if let Err(o) = loop_state.tick(&mut closed) {
                 outcome = o;
@@ -410,6 +427,7 @@ pub fn walk_sequence(
             if closed.sim.has_fallen() {
                 outcome = PhysicsOutcome::Fell {
                     at_s: closed.sim.time(),
+                    after: fault,
                 };
                 break;
             }

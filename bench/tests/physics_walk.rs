@@ -24,9 +24,10 @@ fn physics_walk_needs_the_mujoco_feature() {
 #[cfg(feature = "mujoco")]
 mod walks {
     use client::evaluate::write_fig6;
+    use daemon::controller::FaultCode;
     use stance::{AffordanceSet, WalkRequest};
     use walk_bench::physics::{
-        PhysicsWalkOptions, PhysicsWalkReport, walk_distance, walk_sequence,
+        PhysicsOutcome, PhysicsWalkOptions, PhysicsWalkReport, walk_distance, walk_sequence,
     };
 
     /// `configs/<robot>.toml`.
@@ -176,6 +177,36 @@ mod walks {
     #[test]
     fn armar4_walks_5m_feet_only() {
         check("armar4", AffordanceSet::Feet, 5.0);
+    }
+
+    /// ARMAR-4's static 5 m walk with the left hand, generator seed 8, tips mid-swing: the
+    /// stance sole rolls over its inner edge, which leg odometry cannot see. The tipping fault
+    /// (0.25 rad) came too late, and the robot fell a second later holding its swing foot in the
+    /// air. Now it catches itself on that foot from `catch_tilt_rad` and stands in the fault;
+    /// whether or not a later change keeps it from tipping at all, it must not fall.
+    #[test]
+    fn armar4_tipping_mid_swing_does_not_fall() {
+        let options = PhysicsWalkOptions {
+            settle_s: 3.0,
+            ..PhysicsWalkOptions::default()
+        };
+        let request = WalkRequest {
+            distance: 5.0,
+            affordances: AffordanceSet::FeetLeftHand,
+            seed: 8,
+            speed: None,
+        };
+        let report = walk_distance(&config("armar4"), None, &request, &options).expect("walks");
+        print_report("armar4 feet+left-hand seed 8", 5.0, &report);
+        assert!(
+            matches!(
+                report.outcome,
+                PhysicsOutcome::Done | PhysicsOutcome::Fault(FaultCode::Tipping)
+            ),
+            "ended `{}` at {:.2} s simulated",
+            report.outcome.label(),
+            report.sim_s
+        );
     }
 
     /// Sequences from the learned n-gram model (`data/models/default-ngram.json`, retargeted and

@@ -314,6 +314,72 @@ fn an_imu_tilted_away_from_leg_odometry_is_a_tipping_fault_that_holds() {
     }
 }
 
+/// A static walk tipping mid-swing (the IMU rolled from leg odometry past `catch_tilt_rad`,
+/// short of the tipping fault's angle) does not go on, nor freeze its swing foot in the air: it
+/// puts it straight down, then holds in the tipping fault, standing on both feet.
+#[test]
+fn a_robot_tipping_mid_swing_puts_its_swing_foot_down_then_holds() {
+    let mut h = started("jvrc1", false);
+    run_until(&mut h, Phase::Swing);
+    for _ in 0..20 {
+        h.tick();
+    }
+    let status = *h.closed.controller.status();
+    assert_eq!(status.phase, Phase::Swing, "{status:?}");
+    let swinging = if status.contacts[EndEffector::LeftFoot as usize] {
+        EndEffector::RightFoot
+    } else {
+        EndEffector::LeftFoot
+    };
+    let height = |h: &Harness| h.closed.sim.end_effector_pose(swinging).translation.z;
+    let lifted = height(&h);
+    assert!(lifted > 0.01, "the swing foot is in the air: {lifted} m");
+    let config = walk_support::controller_config("jvrc1");
+    let m = h.closed.sim.measurement().clone();
+    assert!(config.catch_tilt_rad < config.tipping_detection_rad);
+    let roll = (config.catch_tilt_rad + config.tipping_detection_rad) / 2.0;
+    let tipped = nalgebra::UnitQuaternion::from_euler_angles(roll, 0.0, 0.0) * m.base_orientation;
+    let measurement = daemon::controller::Measurement {
+        q: m.q.as_slice(),
+        qd: m.qd.as_slice(),
+        wrenches: &m.wrenches,
+        imu_orientation: Some(tipped),
+    };
+    assert!(
+        h.closed
+            .controller
+            .tick(&measurement, h.dt, &mut h.closed.command)
+    );
+    let status = *h.closed.controller.status();
+    assert_eq!(status.state, ControllerState::ControlledStop, "{status:?}");
+    assert_eq!(status.fault, FaultCode::Tipping);
+    assert_eq!(status.phase, Phase::Swing, "the swing turns into a catch");
+    assert_eq!(h.closed.command.mode, CommandMode::Track, "the foot moves");
+    // Down within two seconds: 0.15 s to the approach height above the ground, then lowered as
+    // every foot is (JVRC-1: 2 cm at 0.02 m/s).
+    let mut ticks = 0;
+    while h.closed.controller.status().state == ControllerState::ControlledStop {
+        assert!(
+            ticks < 2 * RATE_HZ as usize,
+            "still landing after two seconds"
+        );
+        h.tick();
+
+        h.assert_safe();
+        ticks += 1;
+    }
+    let status = *h.closed.controller.status();
+    assert_eq!(status.state, ControllerState::Fault, "{status:?}");
+    assert_eq!(status.fault, FaultCode::Tipping, "the first cause is kept");
+    assert!(
+        status.contacts[EndEffector::LeftFoot as usize]
+            && status.contacts[EndEffector::RightFoot as usize],
+        "stands on both feet: {status:?}"
+    );
+    assert!(height(&h) < 0.005, "landed: {} m", height(&h));
+    assert_eq!(h.closed.command.mode, CommandMode::Hold);
+}
+
 #[test]
 fn the_base_roll_and_pitch_rates_keep_their_own_bound_through_a_walk() {
     let config = walk_support::controller_config("armar4");

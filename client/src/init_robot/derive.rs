@@ -775,6 +775,10 @@ fn controller_heading(key: &str) -> Option<&'static str> {
             "fault (and hold) when the IMU and leg odometry disagree on the base orientation by \
              more than this (rad)"
         }
+        "catch_tilt_rad" => {
+            "with a foot in the air (static gait), put it down at once and end the walk in the \
+             tipping fault when the IMU and leg odometry disagree by more than this (rad)"
+        }
         "carry_released_hands" => {
             "a hand that lets go of the railing is carried along with the pelvis until its next grasp"
         }

@@ -40,7 +40,7 @@ pub enum Tuned {
 }
 
 /// `configs/jvrc1.toml` `[controller]`, in its order.
-pub const CONTROLLER: [(&str, Tuned); 40] = [
+pub const CONTROLLER: [(&str, Tuned); 41] = [
     ("com_weight", Tuned::Number(10.0)),
     ("foot_weight", Tuned::Number(10.0)),
     ("unload_foot_weight", Tuned::Number(10.0)),
@@ -80,6 +80,7 @@ pub const CONTROLLER: [(&str, Tuned); 40] = [
     ("max_step_m", Tuned::Number(0.5)),
     ("command_lead_max_rad", Tuned::Number(0.05)),
     ("tipping_detection_rad", Tuned::Number(0.25)),
+    ("catch_tilt_rad", Tuned::Number(0.05)),
     ("carry_released_hands", Tuned::Switch(true)),
 ];
 

@@ -120,6 +120,11 @@ pub struct ControllerConfig {
     /// count): the stance feet are no longer flat on the ground. Only checked when the
     /// measurement has an IMU.
     pub tipping_detection_rad: f64,
+    /// With a foot in the air (the static gait), a disagreement beyond this smaller angle (rad)
+    /// already puts that foot down at once (a catch step) and ends the walk in the tipping
+    /// fault: a robot tipping over its stance foot's edge mid-swing falls before the feet roll
+    /// by `tipping_detection_rad`. Must stay above the stance sole's ordinary roll.
+    pub catch_tilt_rad: f64,
     /// How fast leg odometry's heading is turned onto the IMU's (rad/s; 0: leg odometry alone).
     /// Odometry cannot see the feet turning together on the ground (down a stair, a touchdown
     /// turns both by up to 0.01 rad, always the same way when the same foot leads), and the walk
@@ -219,6 +224,7 @@ impl Default for ControllerConfig {
             command_lead_max_rad: 0.05,
             unload_foot_weight: 100.0,
             tipping_detection_rad: 0.25,
+            catch_tilt_rad: 0.05,
             heading_correction_speed: 0.05,
             carry_released_hands: false,
             hand_approach_height_m: 0.08,
@@ -411,6 +417,7 @@ impl ControllerConfig {
                 0.01,
                 1.5,
             ),
+            Bound::new("catch_tilt_rad", self.catch_tilt_rad, 0.01, 1.5),
             Bound::new(
                 "heading_correction_speed",
                 self.heading_correction_speed,

@@ -167,6 +167,13 @@ impl ComClimb {
 /// margin plus the CoM tolerance.
 const COM_SETTLE_S: f64 = 0.5;
 
+/// A foot put down to catch a tipping robot comes down to the standing sole's plane within this
+/// time (s), from any swing height. ARMAR-4 tipping mid-swing over its stance sole's edge (MuJoCo,
+/// caught from 0.05 rad): coming down straight to that plane in this time it stood; stopping 2 cm
+/// above it (its approach height) with the slow lowering taking over, it fell. The joints' speed
+/// bounds (`velocity_limit_scale`) cap the motion the QP makes of it.
+const CATCH_S: f64 = 0.15;
+
 /// Execution state of the current sequence.
 pub(crate) struct StateMachine {
     config: ControllerConfig,
@@ -193,6 +200,9 @@ pub(crate) struct StateMachine {
     /// elevation; outside a shift, and with `None`, the height is free (the posture's).
     com_climb: Option<ComClimb>,
     free_targets: [Option<Isometry3<f64>>; 4],
+    /// The foot being put down to end the walk and the pose on the ground below it that
+    /// replaces its stance target (`catch_swing_foot`).
+    catch: Option<(EndEffector, Isometry3<f64>)>,
     /// Released hands, carried along with the pelvis: their pose relative to its planar frame
     /// (x, y, yaw) at release. Planar, so the pelvis roll of ARMAR-4's hip strategy does not
     /// swing them sideways.
@@ -224,6 +234,7 @@ impl StateMachine {
             com_time: 0.0,
             com_climb: None,
             free_targets: [None; 4],
+            catch: None,
             carried: [None; 4],
             targets: Targets::none(),
         }
@@ -289,6 +300,7 @@ impl StateMachine {
     /// Installs a sequence to execute from the next update; returns the previous one.
     pub fn load(&mut self, sequence: Box<PreparedSequence>) -> Option<Box<PreparedSequence>> {
         self.started = false;
+        self.catch = None;
         self.stance = 0;
         self.sequence.replace(sequence)
     }
@@ -296,7 +308,46 @@ impl StateMachine {
     /// Stops executing (the contact set and anchors stay as they are).
     pub fn stop(&mut self) {
         self.started = false;
+        self.catch = None;
         self.deadline = f64::INFINITY;
+    }
+
+    /// Puts the foot in the air down at once, ending the walk: a robot tipping over its stance
+    /// foot towards the lifted one catches itself on it. The rest of the sequence is dropped;
+    /// the foot, at `poses` (world), comes down within [`CATCH_S`] to the sole plane of the foot
+    /// standing, then is lowered as every foot is, until its touchdown is confirmed, and the
+    /// walk ends (`Done`). A tipping robot's estimate holds the standing foot flat, so the
+    /// ground under the lifted foot lies above that plane on the side it tips to, and the foot
+    /// meets it during the fast part. False, and nothing changes, when no foot is lifting,
+    /// swinging or lowering over one standing.
+    pub fn catch_swing_foot(&mut self, poses: &[Isometry3<f64>; 4]) -> bool {
+        let step = self.started.then(|| self.current_step());
+        let Some(Step {
+            phase: Phase::Lift | Phase::Swing | Phase::Lower,
+            end_effector: Some(foot),
+        }) = step
+        else {
+            return false;
+        };
+        let standing = FEET
+            .into_iter()
+            .find(|&f| f != foot && self.targets.contacts[f as usize]);
+        let (Some(standing), true) = (standing, foot.is_foot()) else {
+            return false;
+        };
+        let c = &self.config;
+        let start = poses[foot as usize];
+        let mut below = heading_frame(&start);
+        below.translation.z = self.targets.anchors[standing as usize].translation.z;
+        self.motion = PoseTrajectory::new(start, below, CATCH_S, Profile::Linear);
+        self.motion_is_via = false;
+        self.plan = TransitionPlan::catch(foot);
+        self.step = 0;
+        self.phase_time = 0.0;
+        self.debounce = 0;
+        self.deadline = CATCH_S + c.phase_timeout_s;
+        self.catch = Some((foot, below));
+        true
     }
 
     /// One tick of the sequence: starts it on the first call after `load`, checks the current
@@ -385,7 +436,10 @@ impl StateMachine {
     }
 
     fn world_target(&self, e: EndEffector) -> Isometry3<f64> {
-        self.to_world * self.sequence().stances[self.stance].targets[e as usize]
+        match self.catch {
+            Some((foot, below)) if foot == e => below,
+            _ => self.to_world * self.sequence().stances[self.stance].targets[e as usize],
+        }
     }
 
     /// Height of the contact `foot` swings to: its target in the first stance from the current
@@ -418,9 +472,14 @@ impl StateMachine {
         self.enter_step(feedback);
     }
 
-    /// Moves to the next step or transition; false when the sequence is finished.
+    /// Moves to the next step or transition; false when the sequence is finished (or a caught
+    /// foot touched down).
     fn advance(&mut self, feedback: &Feedback) -> bool {
         self.step += 1;
+        if self.catch.is_some() && self.step == self.plan.steps().len() {
+            self.stop();
+            return false;
+        }
         if self.step < self.plan.steps().len() {
             self.enter_step(feedback);
             return true;
@@ -591,6 +650,12 @@ impl StateMachine {
 
     fn check_step(&mut self, feedback: &Feedback) -> StepStatus {
         let step = self.current_step();
+        let caught_on_ground = match (self.catch, step.phase) {
+            (Some((foot, _)), Phase::Swing) => {
+                self.debounced(feedback.normal_forces[foot as usize] > self.touchdown_force)
+            }
+            _ => false,
+        };
         let c = &self.config;
         let complete = match (step.phase, step.end_effector) {
             (Phase::ShiftCom | Phase::Settle, _) => {
@@ -607,6 +672,8 @@ impl StateMachine {
             (Phase::Lower, Some(foot)) => {
                 self.debounced(feedback.normal_forces[foot as usize] > self.touchdown_force)
             }
+            // A caught foot's fast descent ends where it meets the ground, if that comes first.
+            (Phase::Swing, Some(_)) if caught_on_ground => true,
             (Phase::Lift | Phase::Swing | Phase::Reach, Some(e)) => {
                 let goal = self.motion.goal();
                 let pose = &feedback.poses[e as usize];
@@ -660,8 +727,11 @@ impl StateMachine {
                 // Anchor where the foot landed, at the surface's height: the estimate there
                 // includes the ground compression that confirmed the touchdown, and keeping it
                 // would let the height estimate sink a little with every step.
+                // A caught foot meets the ground wherever it is (it is anchored as estimated).
                 let mut anchor = feedback.poses[i];
-                anchor.translation.z = self.world_target(e).translation.z;
+                if self.catch.is_none() {
+                    anchor.translation.z = self.world_target(e).translation.z;
+                }
                 self.targets.contacts[i] = true;
                 self.targets.anchors[i] = anchor;
                 self.free_targets[i] = None;

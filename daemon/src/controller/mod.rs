@@ -25,7 +25,8 @@
 //! feet, then it holds (`docs/safety.md`, "Controlled stop"). A tick without a usable measurement
 //! meanwhile runs on the last valid state: the joints where the last command sent them, the last
 //! valid wrenches, no IMU, and the plan fed forward. What the controller cannot compute through (a
-//! failed solve, a non-finite command, lost support, tipping) holds at once.
+//! failed solve, a non-finite command, lost support, tipping) holds at once; a static walk tipping
+//! with a foot in the air first puts that foot down (a catch step, `catch_tilt_rad`).
 //!
 //! Joint limits are a hard guarantee: every command written is finite and inside the URDF
 //! limits. A measurement is invalid when it has the wrong size, a non-finite value, or a joint
@@ -528,9 +529,13 @@ impl Controller {
             self.enter_fault(FaultCode::LostSupport);
             return self.write_hold(out);
         }
-        if measured && self.tipping(measurement) {
-            self.enter_fault(FaultCode::Tipping);
-            return self.write_hold(out);
+        if measured {
+            let tilt = self.odometry_tilt_error(measurement);
+            let catching = tilt > self.config.catch_tilt_rad && self.catch_for_tipping();
+            if !catching && tilt > self.config.tipping_detection_rad {
+                self.enter_fault(FaultCode::Tipping);
+                return self.write_hold(out);
+            }
         }
         if !matches!(
             self.status.state,
@@ -650,6 +655,27 @@ impl Controller {
                 }
             }
             _ => self.enter_fault(code),
+        }
+    }
+
+    /// A robot tipping with a foot in the air puts it down before it holds (a catch step,
+    /// `StateMachine::catch_swing_foot`; the static gait), from `catch_tilt_rad` on: frozen in
+    /// the air, that foot stays off the ground the robot tips towards (ARMAR-4, rolling over its
+    /// stance sole's inner edge mid-swing, was detected at 0.25 rad and fell a second later). A
+    /// controlled stop that ends in the tipping fault; true while the foot is coming down.
+    fn catch_for_tipping(&mut self) -> bool {
+        match self.status.state {
+            ControllerState::ControlledStop => {
+                self.stop_ends_in == ControllerState::Fault
+                    && self.status.fault == FaultCode::Tipping
+            }
+            ControllerState::Executing if self.machine.catch_swing_foot(&self.poses) => {
+                self.status.state = ControllerState::ControlledStop;
+                self.status.fault = FaultCode::Tipping;
+                self.stop_ends_in = ControllerState::Fault;
+                true
+            }
+            _ => false,
         }
     }
 
@@ -794,15 +820,15 @@ impl Controller {
         ok
     }
 
-    /// The IMU sees the base tilted away from where leg odometry puts it: the anchored feet are
-    /// no longer flat on the ground. Only the tilt counts (the angle between the two vertical
-    /// axes): a stance foot turning about the vertical makes the yaws differ without any
-    /// tipping.
-    fn tipping(&self, measurement: &Measurement) -> bool {
-        measurement.imu_orientation.is_some_and(|imu| {
+    /// How far the IMU sees the base tilted away from where leg odometry puts it (rad; 0
+    /// without an IMU): above `catch_tilt_rad` / `tipping_detection_rad` the anchored feet are no
+    /// longer flat on the ground. Only the tilt counts (the angle between the two vertical axes): a
+    /// stance foot turning about the vertical makes the yaws differ without any tipping.
+    fn odometry_tilt_error(&self, measurement: &Measurement) -> f64 {
+        measurement.imu_orientation.map_or(0.0, |imu| {
             let up = nalgebra::Vector3::z();
             let estimated = self.configuration.base.rotation * up;
-            (imu * up).angle(&estimated) > self.config.tipping_detection_rad
+            (imu * up).angle(&estimated)
         })
     }
 

@@ -30,13 +30,7 @@ pub(crate) struct TransitionPlan {
 impl TransitionPlan {
     /// The plan from the live contact set `live` to the stance contact flags `next`.
     pub fn new(live: [bool; 4], next: [bool; 4], is_last: bool) -> Self {
-        let mut plan = Self {
-            steps: [Step {
-                phase: Phase::None,
-                end_effector: None,
-            }; MAX_STEPS],
-            len: 0,
-        };
+        let mut plan = Self::empty();
         let added = |e: EndEffector| next[e as usize] && !live[e as usize];
         let released = |e: EndEffector| live[e as usize] && !next[e as usize];
         for e in EndEffector::ALL {
@@ -64,6 +58,25 @@ impl TransitionPlan {
             plan.push(Phase::Settle, None);
         }
         plan
+    }
+
+    /// A catch (`StateMachine::catch_swing_foot`): `foot` brought down over the ground, then
+    /// lowered until it touches down.
+    pub fn catch(foot: EndEffector) -> Self {
+        let mut plan = Self::empty();
+        plan.push(Phase::Swing, Some(foot));
+        plan.push(Phase::Lower, Some(foot));
+        plan
+    }
+
+    fn empty() -> Self {
+        Self {
+            steps: [Step {
+                phase: Phase::None,
+                end_effector: None,
+            }; MAX_STEPS],
+            len: 0,
+        }
     }
 
     fn push(&mut self, phase: Phase, end_effector: Option<EndEffector>) {
@@ -108,6 +121,18 @@ mod tests {
                 .iter()
                 .all(|s| s.end_effector == Some(EndEffector::RightFoot))
         );
+    }
+
+    #[test]
+    fn a_catch_brings_the_foot_over_the_ground_then_lowers_it() {
+        let plan = TransitionPlan::catch(EndEffector::RightFoot);
+        let steps: Vec<_> = plan
+            .steps()
+            .iter()
+            .map(|s| (s.phase, s.end_effector))
+            .collect();
+        let foot = Some(EndEffector::RightFoot);
+        assert_eq!(steps, [(Phase::Swing, foot), (Phase::Lower, foot)]);
     }
 
     #[test]

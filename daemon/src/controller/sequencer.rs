@@ -68,6 +68,12 @@ impl Sequencer {
         self.dynamic.running() && self.dynamic.stop_early(trust_force_sensors)
     }
 
+    /// Puts the static gait's foot in the air down at once, ending the walk
+    /// (`StateMachine::catch_swing_foot`); false when there is none (or a dynamic walk runs).
+    pub fn catch_swing_foot(&mut self, poses: &[Isometry3<f64>; 4]) -> bool {
+        !self.dynamic.running() && self.fallback.catch_swing_foot(poses)
+    }
+
     /// Whether the feet's force-torque readings are trusted: false during a controlled stop that
     /// distrusts them.
     pub fn trusts_force_sensors(&self) -> bool {
