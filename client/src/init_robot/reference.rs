@@ -80,7 +80,7 @@ pub const CONTROLLER: [(&str, Tuned); 41] = [
     ("max_step_m", Tuned::Number(0.5)),
     ("command_lead_max_rad", Tuned::Number(0.05)),
     ("tipping_detection_rad", Tuned::Number(0.25)),
-    ("catch_tilt_rad", Tuned::Number(0.05)),
+    ("catch_tilt_rad", Tuned::Number(0.1)),
     ("carry_released_hands", Tuned::Switch(true)),
 ];
 

@@ -224,7 +224,7 @@ impl Default for ControllerConfig {
             command_lead_max_rad: 0.05,
             unload_foot_weight: 100.0,
             tipping_detection_rad: 0.25,
-            catch_tilt_rad: 0.05,
+            catch_tilt_rad: 0.1,
             heading_correction_speed: 0.05,
             carry_released_hands: false,
             hand_approach_height_m: 0.08,
