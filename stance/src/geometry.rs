@@ -15,11 +15,11 @@ pub fn roll_pitch_yaw(rotation: &UnitQuaternion<f64>) -> [f64; 3] {
 /// direction. Along-path distances (step sizes, the scaling of pass 6) and lateral offsets
 /// (orthogonal foot distance, pass 8) are measured in it.
 ///
-/// The direction ([`crate::passes::path_of`]) is the root's travel from the first stance to the
-/// last, or, for a walk whose root does not travel forward, the mean heading of the feet's
-/// contact poses (sole frames have x forward; toe-out cancels between left and right). No pass
-/// moves a root across the path or against it, so computing it again on a post-processed
-/// sequence gives the same frame. The feet's mean heading alone is off by the walk's toe-out
+/// The direction ([`crate::passes::path_of`]) is the line of the root's travel from the first
+/// stance to the last, pointing where the feet's contact poses head on average (sole frames
+/// have x forward; toe-out cancels between left and right), or that mean heading for a walk
+/// whose root does not travel. No pass moves a root across the path, so computing it again on
+/// a post-processed sequence gives the same frame. The feet's mean heading alone is off by the walk's toe-out
 /// noise and by how long each foot stands (0.2–0.7° on generated walks), and pass 6 keeps the
 /// lateral offsets that error builds up over the raw, human-scale walk: post-processed walks
 /// veered up to 3° (0.26 m over 5 m) from the direction they were generated in, away from their

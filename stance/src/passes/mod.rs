@@ -118,10 +118,14 @@ fn flat_ground() -> &'static Environment {
     &FLAT
 }
 
-/// The walking path of a pose sequence (see [`PathFrame`]): from the first root along the
-/// root's travel to the last stance, or along the mean heading of every contact foot pose when
-/// the root does not travel forward along it (standing, stepping in place, walking backwards);
-/// `None` when empty.
+/// The walking path of a pose sequence (see [`PathFrame`]): from the first root along the line
+/// of the root's travel to the last stance, pointing the way the contact feet head, or along
+/// the feet's mean heading when the root does not travel at all; `None` when empty.
+///
+/// The line, not the travel's sign: pass 7 shortens a short walk's steps along that line and
+/// can bring its last root behind its first (a root ahead of the feet in the first stance), so
+/// a path taken from the travel's sign would turn to the feet's heading on the second run, and
+/// the passes would no longer be idempotent.
 pub fn path_of(poses: &PoseSequence) -> Option<PathFrame> {
     let origin = poses.roots.first()?.translation.vector;
     let contact_feet = (0..poses.len()).flat_map(|i| {
@@ -131,11 +135,12 @@ pub fn path_of(poses: &PoseSequence) -> Option<PathFrame> {
     });
     let heading = PathFrame::of_walk(&origin, contact_feet);
     let travel = poses.roots.last()?.translation.vector - origin;
-    Some(
-        PathFrame::new(&origin, &travel)
-            .filter(|path| path.direction().dot(heading.direction()) > 0.0)
-            .unwrap_or(heading),
-    )
+    let forward = if travel.dot(heading.direction()) < 0.0 {
+        -travel
+    } else {
+        travel
+    };
+    Some(PathFrame::new(&origin, &forward).unwrap_or(heading))
 }
 
 /// The sizes of the robot's contact geometry that the passes need: a foot's sole fits on its
