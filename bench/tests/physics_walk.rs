@@ -209,6 +209,45 @@ mod walks {
         );
     }
 
+    /// JVRC-1 walks the 5 m of `railing.toml`, the rail 0.45 m to its right at 0.8 m: with its
+    /// feet alone in the dynamic gait, and holding the rail with its right hand in the static
+    /// gait (seed 1, whose hand lets go on the rail whenever the right foot steps). Before free
+    /// hands kept clear of railings (`hand_clearance_m`), the hanging right palm swung out under
+    /// the rail and was held down (dynamic: fell 0.34 m along), and a hand let go on top of it
+    /// was pressed into it (static: fell 0.13 m along).
+    #[test]
+    fn jvrc1_walks_beside_a_railing_free_hands_clear_of_it() {
+        let file =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/scenes/railing.toml");
+        let scene = std::sync::Arc::new(stance::Scene::from_path(&file).expect("scene loads"));
+        for (gait, affordances, seed) in [
+            (stance::Gait::Dynamic, AffordanceSet::Feet, 0),
+            (stance::Gait::Static, AffordanceSet::FeetRightHand, 1),
+        ] {
+            let options = PhysicsWalkOptions {
+                gait,
+                scene: Some(scene.clone()),
+                ..PhysicsWalkOptions::default()
+            };
+            let request = WalkRequest {
+                distance: scene.path_length(),
+                affordances,
+                seed,
+                speed: None,
+            };
+            let report = walk_distance(&config("jvrc1"), None, &request, &options).expect("walks");
+            let label = format!("jvrc1 railing {gait:?} {affordances} seed {seed}");
+            print_report(&label, request.distance, &report);
+            assert!(
+                report.outcome == PhysicsOutcome::Done,
+                "{label}: ended `{}` at {:.2} s simulated, {:.2} m along",
+                report.outcome.label(),
+                report.sim_s,
+                report.distance_m
+            );
+        }
+    }
+
     /// Sequences from the learned n-gram model (`data/models/default-ngram.json`, retargeted and
     /// post-processed) walk under physics too: each affordance set, 1 m, seed 0.
     fn check_learned(robot: &str) {

@@ -7,6 +7,9 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use daemon::controller::{ControllerState, Measurement, Phase};
+use kinematics::Kinematics;
+use kinematics::robot::EndEffector;
+use nalgebra::Vector3;
 
 struct Counting;
 
@@ -40,7 +43,22 @@ static GLOBAL: Counting = Counting;
 fn controller_tick_does_not_allocate() {
     for robot in ["jvrc1", "armar4"] {
         let mut h = walk_support::Harness::new(robot, 200.0);
-        let sequence = walk_support::synthetic_walk(&h.robot, 2, 0.08, true);
+        // A railing 5 cm right of the free right hand: it keeps clear of it on every tick.
+        let mut kinematics = Kinematics::new(&h.robot.model);
+        kinematics.update(&h.robot.model, &h.robot.standing);
+        let right_hand = kinematics
+            .frame_pose(&h.robot.model, h.robot.frame(EndEffector::RightHand))
+            .translation
+            .vector;
+        let mut environment = stance::Environment::default();
+        environment.hand_affordances.push(stance::HandAffordance {
+            name: "railing".to_owned(),
+            start: right_hand + Vector3::new(-1.0, -0.05, 0.0),
+            end: right_hand + Vector3::new(2.0, -0.05, 0.0),
+            radius: 0.02,
+            available: [0.0, 1.0],
+        });
+        let sequence = walk_support::synthetic_walk_in(&h.robot, 2, 0.08, true, environment);
         h.start(&sequence);
         let end = walk_counting_allocations(robot, h, |_, _| {});
         assert_eq!(end, ControllerState::Done, "{robot}");

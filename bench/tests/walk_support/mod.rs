@@ -47,6 +47,17 @@ pub fn controller_config(name: &str) -> ControllerConfig {
 /// the ground halfway. Postures are the standing posture. With `hand`, the left hand first
 /// takes a contact 3 cm in front of where it hangs and keeps it to the end.
 pub fn synthetic_walk(robot: &Robot, steps: usize, step: f64, hand: bool) -> PostProcessedSequence {
+    synthetic_walk_in(robot, steps, step, hand, Environment::default())
+}
+
+/// [`synthetic_walk`] in `environment` (its railings, for instance).
+pub fn synthetic_walk_in(
+    robot: &Robot,
+    steps: usize,
+    step: f64,
+    hand: bool,
+    environment: Environment,
+) -> PostProcessedSequence {
     let mut kinematics = Kinematics::new(&robot.model);
     kinematics.update(&robot.model, &robot.standing);
     let mut poses = EndEffector::ALL.map(|e| kinematics.frame_pose(&robot.model, robot.frame(e)));
@@ -98,7 +109,7 @@ pub fn synthetic_walk(robot: &Robot, steps: usize, step: f64, hand: bool) -> Pos
     PostProcessedSequence::new(
         robot.name.clone(),
         robot.model.joint_names().to_vec(),
-        Environment::default(),
+        environment,
         stances,
         targets,
     )

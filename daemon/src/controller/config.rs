@@ -140,6 +140,13 @@ pub struct ControllerConfig {
     /// How high (m) a hand's reach arcs above the straight line to its contact, at its middle:
     /// it comes down onto the top of a railing instead of sweeping into it from below.
     pub hand_approach_height_m: f64,
+    /// How far (m) a hand that holds nothing keeps its palm from the surface of a railing of the
+    /// walk's scene (`hand_clearance`): a free palm that swings into a rail, or under it, hooks
+    /// the robot to it (JVRC-1's hanging palm is 7 cm from a rail 0.45 m beside its path).
+    pub hand_clearance_m: f64,
+    /// Fastest a free hand's target moves out of a railing's way (m/s): a hand let go on the
+    /// rail lifts off it at this speed.
+    pub hand_clearance_speed: f64,
     /// The vertical force (N) a held hand presses on its support with, measured at its wrist:
     /// enough to know it is there, little enough not to unload a foot the balance does not
     /// expect to be unloaded (`hand_press`).
@@ -228,6 +235,8 @@ impl Default for ControllerConfig {
             heading_correction_speed: 0.05,
             carry_released_hands: false,
             hand_approach_height_m: 0.08,
+            hand_clearance_m: 0.05,
+            hand_clearance_speed: 0.2,
             hand_force_n: 10.0,
             hand_admittance: 5e-4,
             hand_press_speed: 0.05,
@@ -429,6 +438,13 @@ impl ControllerConfig {
                 self.hand_approach_height_m,
                 0.0,
                 0.5,
+            ),
+            Bound::new("hand_clearance_m", self.hand_clearance_m, 0.0, 0.5),
+            Bound::new(
+                "hand_clearance_speed",
+                self.hand_clearance_speed,
+                0.001,
+                2.0,
             ),
             Bound::new("hand_force_n", self.hand_force_n, 0.0, 1000.0),
             Bound::new("hand_admittance", self.hand_admittance, 0.0, 0.01),

@@ -56,6 +56,9 @@ pub(crate) struct Targets {
     pub end_effectors: [Option<PoseTarget>; 4],
     /// The foot being unloaded: out of the contact set but still on the ground.
     pub unloading: Option<EndEffector>,
+    /// Hands on their way to a contact (`EndEffector` order; a reach under way), which may come
+    /// as close to a railing as they need to.
+    pub reaching: [bool; 4],
     /// How the QP keeps the robot balanced.
     pub balance: Balance,
     /// Velocities of the feet in contact on top of holding their anchors (linear xyz, angular
@@ -76,6 +79,7 @@ impl Targets {
             com_velocity: Vector2::zeros(),
             end_effectors: [None; 4],
             unloading: None,
+            reaching: [false; 4],
             balance: Balance::SupportPolygon { height: None },
             contact_velocity: [[0.0; 6]; 2],
             torso_posture_weight: None,
@@ -274,6 +278,11 @@ impl StateMachine {
     /// The live targets, to turn their anchors with the estimate's heading.
     pub fn targets_mut(&mut self) -> &mut Targets {
         &mut self.targets
+    }
+
+    /// The loaded sequence and the pose of its frame in the world (set when the walk begins).
+    pub fn sequence_in_world(&self) -> Option<(&PreparedSequence, &Isometry3<f64>)> {
+        Some((self.sequence.as_deref()?, &self.to_world))
     }
 
     /// The posture reference of the stance being moved towards.
@@ -767,6 +776,9 @@ impl StateMachine {
         self.targets.unloading = step
             .filter(|step| step.phase == Phase::Unload)
             .and_then(|step| step.end_effector);
+        self.targets.reaching = EndEffector::ALL.map(|e| {
+            step.is_some_and(|step| step.phase == Phase::Reach && step.end_effector == Some(e))
+        });
         for e in EndEffector::ALL {
             let i = e as usize;
             self.targets.end_effectors[i] = if Some(e) == moving {

@@ -40,6 +40,7 @@ mod assembly;
 mod config;
 mod estimator;
 mod gait;
+mod hand_clearance;
 mod hand_press;
 mod machine;
 mod plan;
@@ -69,6 +70,7 @@ pub use telemetry::ControllerTelemetry;
 use assembly::QpAssembler;
 use estimator::BaseEstimator;
 use gait::{DynamicPlan, Sensors};
+use hand_clearance::HandClearance;
 use hand_press::HandPress;
 use machine::{Feedback, Progress};
 use sequencer::Sequencer;
@@ -246,6 +248,8 @@ pub struct Controller {
     last_wrenches: [[f64; 6]; 4],
     /// The held hands' force regulation on their targets.
     hand_press: HandPress,
+    /// The free hands' offsets out of the walk's railings' way.
+    hand_clearance: HandClearance,
     /// Joint angles and velocities of a tick on the last valid state (preallocated).
     substitute_q: Vec<f64>,
     substitute_qd: Vec<f64>,
@@ -291,6 +295,7 @@ impl Controller {
             last_imu: None,
             last_wrenches: [[0.0; 6]; 4],
             hand_press: HandPress::default(),
+            hand_clearance: HandClearance::default(),
             substitute_q: vec![0.0; model.dof()],
             substitute_qd: vec![0.0; model.dof()],
             stop_ends_in: ControllerState::Holding,
@@ -589,6 +594,14 @@ impl Controller {
         let mut targets = *self.machine.targets();
         self.hand_press
             .apply(&mut targets, measurement.wrenches, &self.config, dt);
+        self.hand_clearance.apply(
+            &mut targets,
+            &self.poses,
+            self.machine.railings(),
+            self.robot.palm_radius,
+            &self.config,
+            dt,
+        );
         self.assembler.assemble(
             &self.robot,
             &self.machine.qp_config(&self.config),

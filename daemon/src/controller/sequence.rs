@@ -6,6 +6,7 @@ use nalgebra::{DVector, Isometry3};
 
 use super::config::ControllerConfig;
 use super::gait::DynamicPlan;
+use super::hand_clearance::RailAxis;
 
 /// Tolerance on the posture's joint limits (rad): `q_S` from IK sits on a limit at most by round-off.
 const LIMIT_TOLERANCE: f64 = 1e-6;
@@ -36,6 +37,9 @@ pub struct PreparedSequence {
     pub(crate) stances: Vec<PreparedStance>,
     /// The dynamic gait's plan; `None` for the static gait.
     pub(crate) dynamic: Option<Box<DynamicPlan>>,
+    /// The scene's railings, in the sequence's world frame: free hands keep clear of them
+    /// (`hand_clearance`).
+    pub(crate) railings: Vec<RailAxis>,
 }
 
 impl PreparedSequence {
@@ -51,6 +55,16 @@ impl PreparedSequence {
     /// Number of stances.
     pub fn len(&self) -> usize {
         self.stances.len()
+    }
+
+    /// The scene's railings seen through `to_world` (the sequence frame's pose in the world).
+    pub(crate) fn railings_in<'a>(
+        &'a self,
+        to_world: &'a Isometry3<f64>,
+    ) -> impl Iterator<Item = RailAxis> + Clone + 'a {
+        self.railings
+            .iter()
+            .map(|railing| railing.transformed(to_world))
     }
 
     /// Always false: an empty sequence is refused.
@@ -128,6 +142,7 @@ impl PreparedSequence {
         Ok(Self {
             stances,
             dynamic: None,
+            railings: RailAxis::of_scene(&seq.environment().hand_affordances),
         })
     }
 }

@@ -8,6 +8,7 @@ use nalgebra::{DVector, Isometry3};
 
 use super::config::ControllerConfig;
 use super::gait::{DynamicWalker, Sensors};
+use super::hand_clearance::RailAxis;
 use super::machine::{Feedback, Progress, StateMachine, Targets};
 use super::sequence::PreparedSequence;
 use super::status::{BalanceStatus, Phase};
@@ -124,6 +125,18 @@ impl Sequencer {
     /// World anchors of the feet in contact, for the estimator.
     pub fn foot_anchors(&self) -> [Option<&Isometry3<f64>>; 2] {
         self.targets().foot_anchors()
+    }
+
+    /// The railings of the running gait's sequence, in the world (`hand_clearance`).
+    pub fn railings(&self) -> impl Iterator<Item = RailAxis> + Clone + '_ {
+        let running = if self.dynamic_selected {
+            self.dynamic.sequence_in_world()
+        } else {
+            self.fallback.sequence_in_world()
+        };
+        running
+            .into_iter()
+            .flat_map(|(sequence, to_world)| sequence.railings_in(to_world))
     }
 
     /// The posture reference of the stance being moved towards.

@@ -189,6 +189,7 @@ impl DynamicWalker {
     pub fn take_over(&mut self, live: &Targets) {
         self.targets = *live;
         self.targets.unloading = None;
+        self.targets.reaching = [false; 4];
         self.targets.end_effectors = [None; 4];
         self.targets.contact_velocity = [[0.0; 6]; 2];
         self.carried = [None; 2];
@@ -267,6 +268,11 @@ impl DynamicWalker {
     /// The balance readings of the last update.
     pub fn balance(&self) -> &BalanceStatus {
         &self.balance
+    }
+
+    /// The loaded sequence and the pose of its frame in the world (set when the walk begins).
+    pub fn sequence_in_world(&self) -> Option<(&PreparedSequence, &Isometry3<f64>)> {
+        Some((self.sequence.as_deref()?, &self.to_world))
     }
 
     /// The posture reference: the stance the current phases lead to.
@@ -759,6 +765,7 @@ impl DynamicWalker {
         }
         for (k, hand) in EndEffector::HANDS.iter().enumerate() {
             let h = *hand as usize;
+            self.targets.reaching[h] = !self.targets.contacts[h] && self.reaches[k].is_some();
             self.targets.end_effectors[h] = if self.targets.contacts[h] {
                 Some(PoseTarget {
                     pose: self.targets.anchors[h],
