@@ -159,10 +159,7 @@ impl HandAffordance {
     /// The point of the segment nearest to `point`: where a hand reaching for the railing from
     /// there grasps it.
     pub fn nearest_on_axis(&self, point: &Vector3<f64>) -> Vector3<f64> {
-        let axis = self.end - self.start;
-        let t = (point - self.start).dot(&axis) / axis.norm_squared();
-        // A degenerate segment (start = end) gives NaN: its only point.
-        self.start + axis * if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) }
+        crate::geometry::nearest_on_segment(&self.start, &self.end, point)
     }
 
     /// Whether `hand` may hold the railing: it lies on that hand's side of the walk (its

@@ -11,6 +11,19 @@ pub fn roll_pitch_yaw(rotation: &UnitQuaternion<f64>) -> [f64; 3] {
     [roll, pitch, yaw]
 }
 
+/// The point of the segment from `start` to `end` nearest to `point` (`start` for a segment of
+/// no length): where a hand reaching for a railing's axis from `point` meets it.
+pub fn nearest_on_segment(
+    start: &Vector3<f64>,
+    end: &Vector3<f64>,
+    point: &Vector3<f64>,
+) -> Vector3<f64> {
+    let axis = end - start;
+    let t = (point - start).dot(&axis) / axis.norm_squared();
+    // A degenerate segment (start = end) gives NaN: its only point.
+    start + axis * if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) }
+}
+
 /// The straight walking path of a sequence: an origin on the ground plane and a horizontal unit
 /// direction. Along-path distances (step sizes, the scaling of pass 6) and lateral offsets
 /// (orthogonal foot distance, pass 8) are measured in it.

@@ -17,6 +17,7 @@
 
 use kinematics::robot::EndEffector;
 use nalgebra::{Isometry3, Vector3};
+use stance::geometry::nearest_on_segment;
 
 use super::config::ControllerConfig;
 use super::machine::{PoseTarget, Targets};
@@ -54,13 +55,7 @@ impl RailAxis {
 
     /// The point of the axis nearest to `point`.
     fn nearest(&self, point: &Vector3<f64>) -> Vector3<f64> {
-        let axis = self.end - self.start;
-        let length_squared = axis.norm_squared();
-        if length_squared == 0.0 {
-            return self.start;
-        }
-        let t = (point - self.start).dot(&axis) / length_squared;
-        self.start + axis * t.clamp(0.0, 1.0)
+        nearest_on_segment(&self.start, &self.end, point)
     }
 }
 

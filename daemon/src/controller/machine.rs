@@ -338,13 +338,12 @@ impl StateMachine {
         else {
             return false;
         };
-        let standing = FEET
+        let Some(standing) = FEET
             .into_iter()
-            .find(|&f| f != foot && self.targets.contacts[f as usize]);
-        let (Some(standing), true) = (standing, foot.is_foot()) else {
+            .find(|&f| foot.is_foot() && f != foot && self.targets.contacts[f as usize])
+        else {
             return false;
         };
-        let c = &self.config;
         let start = poses[foot as usize];
         let mut below = heading_frame(&start);
         below.translation.z = self.targets.anchors[standing as usize].translation.z;
@@ -354,7 +353,7 @@ impl StateMachine {
         self.step = 0;
         self.phase_time = 0.0;
         self.debounce = 0;
-        self.deadline = CATCH_S + c.phase_timeout_s;
+        self.deadline = CATCH_S + self.config.phase_timeout_s;
         self.catch = Some((foot, below));
         true
     }
