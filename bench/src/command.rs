@@ -284,6 +284,7 @@ struct JsonReport {
     max_contact_slip_m: f64,
     joint_limit_violations: u64,
     distance_m: f64,
+    reaches_given_up: u32,
 }
 
 fn print_report(
@@ -308,6 +309,7 @@ fn print_report(
             max_contact_slip_m: safety.max_contact_slip,
             joint_limit_violations: safety.joint_limit_violations,
             distance_m: report.distance_m,
+            reaches_given_up: report.reaches_given_up,
         };
         match serde_json::to_string(&value) {
             Ok(line) => println!("{line}"),
@@ -331,6 +333,7 @@ fn print_report(
         report.ticks as f64 / rate_hz
     );
     println!("  distance walked        {:.3} m", report.distance_m);
+    println!("  hand reaches given up  {}", report.reaches_given_up);
     for (name, h) in [("tick", &timing.tick), ("qp solve", &timing.qp)] {
         println!(
             "  {name:<22} p50 {:.2} µs  p99 {:.2} µs  max {:.2} µs",

@@ -125,6 +125,7 @@ impl MatrixRun {
             drift_m: None,
             max_tilt_rad: 0.0,
             actuators: None,
+            reaches_given_up: None,
         };
         match result {
             Err(error) => Self {
@@ -144,6 +145,7 @@ impl MatrixRun {
                     drift_m: Some(report.drift_m()),
                     max_tilt_rad: report.max_tilt_rad,
                     actuators: Some(report.actuators.clone()),
+                    reaches_given_up: Some(report.reaches_given_up),
                     ..record(report.outcome.label())
                 },
                 error: None,
@@ -370,12 +372,13 @@ fn run_line(run: &MatrixRun) -> String {
         );
     }
     format!(
-        "{} {} m seed {}: {} after {} stances, {:.3} m in {:.2} s, {}, drift {:.3} m, tilt {:.3} \
-         rad, ZMP rms {:.3} m, DCM rms {:.3} m, tick p50 {:.1} p99 {:.1} µs",
+        "{} {} m seed {}: {}{} after {} stances, {:.3} m in {:.2} s, {}, drift {:.3} m, tilt \
+         {:.3} rad, ZMP rms {:.3} m, DCM rms {:.3} m, tick p50 {:.1} p99 {:.1} µs",
         r.affordances,
         r.distance_m,
         r.seed,
         r.outcome,
+        r.reaches_given_up_note(),
         r.stances,
         r.walked_m,
         r.sim_s,

@@ -155,6 +155,8 @@ pub struct PhysicsWalkReport {
     pub stances: usize,
     /// The stance the controller was moving towards at the end.
     pub stance_reached: u32,
+    /// Hand reaches the controller gave up (`ControllerStatus::reaches_given_up`).
+    pub reaches_given_up: u32,
     /// Control ticks until the outcome (settle time excluded).
     pub ticks: u64,
     /// Simulated time until the outcome (s, settle time excluded).
@@ -442,6 +444,7 @@ pub fn walk_sequence(
         outcome,
         stances: sequence.len(),
         stance_reached: closed.controller.status().stance_index,
+        reaches_given_up: closed.controller.status().reaches_given_up,
         ticks,
         sim_s,
         wall_s,

@@ -112,6 +112,8 @@ pub struct WalkReport {
     pub safety: SafetySummary,
     /// Horizontal distance the feet midpoint travelled (m, simulator truth).
     pub distance_m: f64,
+    /// Hand reaches the controller gave up (`ControllerStatus::reaches_given_up`).
+    pub reaches_given_up: u32,
 }
 
 /// Errors setting up or running a walk.
@@ -187,5 +189,6 @@ pub fn walk(
         ticks,
         safety: *closed.sim.summary(),
         distance_m: (feet_midpoint(&closed.sim) - start_midpoint).norm(),
+        reaches_given_up: closed.controller.status().reaches_given_up,
     })
 }

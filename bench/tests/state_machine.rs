@@ -481,6 +481,61 @@ fn a_released_hand_is_carried_with_the_pelvis_only_when_configured() {
     }
 }
 
+/// The synthetic walk with the left hand held from its second stance on, at a grasp 0.6 m
+/// further out than the standing posture puts it: beyond the arm's reach.
+fn walk_reaching_too_far(h: &Harness) -> stance::PostProcessedSequence {
+    let held = walk_support::synthetic_walk(&h.robot, 4, 0.08, true);
+    let left_hand = EndEffector::LeftHand as usize;
+    let mut targets: Vec<_> = (0..held.len()).map(|i| *held.targets(i)).collect();
+    for (stance, target) in held.stances().iter().zip(&mut targets) {
+        if stance.contacts[left_hand] {
+            target[left_hand].translation.vector.y += 0.6;
+        }
+    }
+    stance::PostProcessedSequence::new(
+        held.robot().to_owned(),
+        held.joint_names().to_vec(),
+        held.environment().clone(),
+        held.stances().to_vec(),
+        targets,
+    )
+    .unwrap()
+}
+
+#[test]
+fn a_hand_that_cannot_reach_its_contact_is_let_go_and_the_walk_goes_on() {
+    let mut h = Harness::new("jvrc1", RATE_HZ);
+    let sequence = walk_reaching_too_far(&h);
+    let left_hand = EndEffector::LeftHand as usize;
+    let planned_runs = 1;
+    assert!(
+        sequence
+            .stances()
+            .iter()
+            .filter(|s| s.contacts[left_hand])
+            .count()
+            > 2
+    );
+    h.start(&sequence);
+    let mut reaches = 0;
+    let mut previous = Phase::None;
+    walk_to_done(&mut h, |h| {
+        let status = h.closed.controller.status();
+        assert!(
+            !status.contacts[left_hand],
+            "stance {}: the hand never reached, yet counts as a contact",
+            status.stance_index
+        );
+        if status.phase == Phase::Reach && previous != Phase::Reach {
+            reaches += 1;
+        }
+        previous = status.phase;
+    });
+    // One reach, given up once: the rest of its contact run is walked without the hand.
+    assert_eq!(reaches, planned_runs);
+    assert_eq!(h.closed.controller.status().reaches_given_up, planned_runs);
+}
+
 /// The heading about the vertical of a status pose `[x, y, z, qx, qy, qz, qw]` (rad).
 fn heading_of(pose: &[f64; 7]) -> f64 {
     kinematics::ground::yaw(&nalgebra::UnitQuaternion::from_quaternion(

@@ -274,6 +274,19 @@ pub struct RunResult {
 impl RunResult {
     fn json(&self) -> serde_json::Value {
         let r = &self.record;
+        let injected = self.stop.map(|stop| {
+            serde_json::json!({
+                "fault": stop.injection.fault.name(),
+                "at": stop.injection.moment.name(),
+                "step": stop.injection.step,
+                "delay_s": stop.injection.delay_s,
+                "stop_s": stop.stop_s,
+                "ended": stop.ended.name(),
+                "feet_down": stop.feet_down,
+                "fell": stop.fell,
+                "max_tilt_rad": stop.max_tilt_rad,
+            })
+        });
         serde_json::json!({
             "robot": self.robot,
             "affordances": r.affordances.name(),
@@ -303,19 +316,10 @@ impl RunResult {
             "foothold_error_m": self.steps.foothold_error_m,
             "edge_clearance_m": self.steps.edge_clearance_m,
             "hand_support_share": self.hand_support_share,
+            "reaches_given_up": r.reaches_given_up,
             "requested_speed_m_s": self.requested_speed_m_s,
             "timing": self.timing,
-            "injected": self.stop.map(|stop| serde_json::json!({
-                "fault": stop.injection.fault.name(),
-                "at": stop.injection.moment.name(),
-                "step": stop.injection.step,
-                "delay_s": stop.injection.delay_s,
-                "stop_s": stop.stop_s,
-                "ended": stop.ended.name(),
-                "feet_down": stop.feet_down,
-                "fell": stop.fell,
-                "max_tilt_rad": stop.max_tilt_rad,
-            })),
+            "injected": injected,
         })
     }
 }
@@ -586,7 +590,8 @@ fn run_once(
                 affordances.name()
             ))
         }),
-        balance: gait == Gait::Dynamic || injection.is_some(),
+        // Always: the static gait's hand contacts (`reaches_given_up`) come from it too.
+        telemetry: true,
         // After a stop, watch a while longer whether the robot stays up.
         linger: Duration::from_secs(u64::from(injection.is_some())),
         timeout: Duration::from_secs(120 + 60 * sequence.len() as u64),
@@ -678,6 +683,13 @@ fn run_once(
             sim_s: walk.sim_s,
             drift_m: walk.drift.map(|(largest, _)| largest),
             max_tilt_rad: verdict.max_tilt_rad,
+            // Only the static gait waits for a hand and gives it up; the dynamic gait's reaches
+            // run on time, and its telemetry never shows a hand held only in the first stance.
+            reaches_given_up: walk
+                .hands_held
+                .as_ref()
+                .filter(|_| gait == Gait::Static)
+                .map(|held| hands::reaches_given_up(&contacts, held, last.stance_index as usize)),
             actuators: (args.physics == Physics::Mujoco)
                 .then(|| ActuatorReport::new(&verdict.end.actuators, model)),
         },
@@ -707,7 +719,7 @@ fn row(result: &RunResult) -> String {
         r.distance_m,
         r.seed,
         if r.success { "ok" } else { "FAIL" },
-        r.outcome,
+        format!("{}{}", r.outcome, r.reaches_given_up_note()),
         r.sim_s,
         result.wall_s,
         r.sim_s / result.wall_s,

@@ -1,13 +1,15 @@
 //! The balance of a dynamic walk over the real processes: walkd's per-tick telemetry
 //! (`<prefix>/telemetry`, read by the observer's [`Source`]) kept on a thread of its own, every
 //! [`KEEP_EVERY`]th tick that carries ZMP and DCM, for the balance row of Fig. 6, every tick
-//! at which the daemon's state changed (to time a controlled stop to the tick), and every planned
-//! support phase the dynamic gait entered ([`super::timing`]).
+//! at which the daemon's state changed (to time a controlled stop to the tick), every planned
+//! support phase the dynamic gait entered ([`super::timing`]), and the stances in which each hand
+//! was in the controller's contact set ([`super::hands::reaches_given_up`]).
 
 use std::sync::mpsc::Receiver;
 use std::thread::JoinHandle;
 
 use anyhow::Context;
+use kinematics::robot::EndEffector;
 use shm_types::{DaemonState, Telemetry};
 
 use super::fig6::BalanceSample;
@@ -16,6 +18,11 @@ use crate::observe::source::{Batch, Source};
 
 /// One telemetry in this many is kept (at 500 Hz: 100 samples a second).
 pub(crate) const KEEP_EVERY: u64 = 5;
+
+/// Stance indices past this are not tracked for the hands (a corrupt index cannot make the
+/// recorder allocate without bound; walkd takes at most `[runtime] max_stances`, 10 000 by
+/// default).
+const MAX_STANCES: usize = 1_000_000;
 
 /// A tick at which the daemon's state changed.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -34,6 +41,7 @@ struct Kept {
     balance: Vec<Telemetry>,
     changes: Vec<StateChange>,
     phases: Vec<PlannedPhase>,
+    hands_held: Vec<[bool; 2]>,
 }
 
 /// What a walk's telemetry showed, from the tick it started.
@@ -44,6 +52,9 @@ pub(crate) struct RecordedBalance {
     pub state_changes: Vec<StateChange>,
     /// The dynamic gait's planned support phases, in order.
     pub phases: Vec<PlannedPhase>,
+    /// By stance index (the stance walkd moved towards): whether the left and the right hand
+    /// were in its contact set at any tick.
+    pub hands_held: Vec<[bool; 2]>,
 }
 
 /// The ticks and ZMP/DCM of a walk's telemetry, until [`BalanceRecorder::finish`].
@@ -92,12 +103,13 @@ impl BalanceRecorder {
             samples: balance,
             state_changes: changes,
             phases: kept.phases,
+            hands_held: kept.hands_held,
         })
     }
 }
 
-/// Keeps every [`KEEP_EVERY`]th telemetry with ZMP and DCM, every state change and every new
-/// planned phase, until the batches end.
+/// Keeps every [`KEEP_EVERY`]th telemetry with ZMP and DCM, every state change, every new
+/// planned phase and the hands in contact per stance, until the batches end.
 fn collect(batches: &Receiver<Batch>) -> Kept {
     let mut kept = Kept::default();
     let mut state = None;
@@ -116,10 +128,62 @@ fn collect(batches: &Receiver<Batch>) -> Kept {
             if phase.is_some() && phase.as_ref() != kept.phases.last() {
                 kept.phases.extend(phase);
             }
+            let hands = EndEffector::HANDS.map(|hand| telemetry.contacts[hand as usize].is_set());
+            let stance = telemetry.stance_index as usize;
+            if hands.contains(&true) && stance < MAX_STANCES {
+                if kept.hands_held.len() <= stance {
+                    kept.hands_held.resize(stance + 1, [false; 2]);
+                }
+                for (held, now) in kept.hands_held[stance].iter_mut().zip(hands) {
+                    *held |= now;
+                }
+            }
             if telemetry.dynamics_valid.is_set() && telemetry.tick % KEEP_EVERY == 0 {
                 kept.balance.push(telemetry);
             }
         }
     }
     kept
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shm_types::Flag;
+
+    fn telemetry(stance_index: u32, left_hand: bool, right_hand: bool) -> Telemetry {
+        let mut telemetry = Telemetry::ZERO;
+        telemetry.stance_index = stance_index;
+        telemetry.contacts[EndEffector::LeftHand as usize] = Flag::from(left_hand);
+        telemetry.contacts[EndEffector::RightHand as usize] = Flag::from(right_hand);
+        telemetry
+    }
+
+    #[test]
+    fn the_hands_in_contact_are_kept_per_stance() {
+        let (send, receive) = std::sync::mpsc::channel();
+        let batch = |telemetry| Batch {
+            telemetry,
+            samples: Vec::new(),
+            commands: Vec::new(),
+            statuses: Vec::new(),
+            refused: Vec::new(),
+        };
+        send.send(batch(vec![
+            telemetry(0, false, false),
+            telemetry(2, false, true),
+            telemetry(2, false, false),
+        ]))
+        .unwrap();
+        send.send(batch(vec![telemetry(3, true, false)])).unwrap();
+        // A corrupt stance index is not tracked (no allocation without bound).
+        send.send(batch(vec![telemetry(u32::MAX, true, true)]))
+            .unwrap();
+        drop(send);
+        let kept = collect(&receive);
+        assert_eq!(
+            kept.hands_held,
+            [[false; 2], [false; 2], [false, true], [true, false]]
+        );
+    }
 }

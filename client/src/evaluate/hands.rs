@@ -43,9 +43,62 @@ pub(crate) fn support_share(
     (count > 0).then(|| sum / count as f64 / weight_n)
 }
 
+/// The planned hand contact runs (a hand in contact through consecutive stances of `contacts`,
+/// the sequence's flags) that walkd went on without: no tick of the run's stances had the hand
+/// in its contact set (`hands_held`, per stance index, from its telemetry). Only runs the walk
+/// got to the end of (their last stance at most `reached`, the stance walkd last moved towards)
+/// count, so a walk that stopped mid-run is not counted as having given up its hand.
+pub(crate) fn reaches_given_up(
+    contacts: &[[bool; 4]],
+    hands_held: &[[bool; 2]],
+    reached: usize,
+) -> u32 {
+    let held = |i: usize, k: usize| hands_held.get(i).is_some_and(|held| held[k]);
+    let mut given_up = 0;
+    for (k, hand) in EndEffector::HANDS.iter().enumerate() {
+        let mut run_start = None;
+        for i in 0..=contacts.len() {
+            let planned = contacts.get(i).is_some_and(|c| c[*hand as usize]);
+            match (planned, run_start) {
+                (true, None) => run_start = Some(i),
+                (false, Some(start)) => {
+                    run_start = None;
+                    if i - 1 <= reached && !(start..i).any(|s| held(s, k)) {
+                        given_up += 1;
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    given_up
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_planned_hand_run_never_held_counts_as_given_up_once_walked_past() {
+        let feet = [true, true, false, false];
+        let left = [true, true, true, false];
+        let right = [true, true, false, true];
+        // Left held in stances 1-2, right planned in 4-5, left again in 7.
+        let contacts = [feet, left, left, feet, right, right, feet, left];
+        let mut held = vec![[false; 2]; 8];
+        held[2][0] = true;
+        // The right run was never held, the last left one neither.
+        assert_eq!(reaches_given_up(&contacts, &held, 7), 2);
+        // A walk that stopped in the right run has not given it up (yet).
+        assert_eq!(reaches_given_up(&contacts, &held, 4), 0);
+        assert_eq!(reaches_given_up(&contacts, &held, 5), 1);
+        // Held in one stance of each run: none given up.
+        held[5][1] = true;
+        held[7][0] = true;
+        assert_eq!(reaches_given_up(&contacts, &held, 7), 0);
+        // No telemetry at all: every run walked past counts.
+        assert_eq!(reaches_given_up(&contacts, &[], 7), 3);
+    }
 
     fn state(seq: u64, right_hand_z: f64) -> SimTruth {
         SimTruth {

@@ -101,6 +101,21 @@ pub struct WalkRecord {
     /// How hard the walk worked the motors (`None` without actuator dynamics: kinematic
     /// physics).
     pub actuators: Option<ActuatorReport>,
+    /// Planned hand contacts the walk went on without: the static gait gives up a reach that
+    /// does not get there in time, and the hand stays free for the rest of that contact run
+    /// (docs/controller.md, "Hands on a railing"). `None` when not measured.
+    pub reaches_given_up: Option<u32>,
+}
+
+impl WalkRecord {
+    /// `, N hand reaches given up` when the walk went on without a planned hand contact, else
+    /// nothing: a walk that is `done` without all its hands says so in its line.
+    pub fn reaches_given_up_note(&self) -> String {
+        match self.reaches_given_up {
+            Some(n) if n > 0 => format!(", {n} hand reaches given up"),
+            _ => String::new(),
+        }
+    }
 }
 
 fn affordance_name<S: Serializer>(set: &AffordanceSet, serializer: S) -> Result<S::Ok, S::Error> {
@@ -209,6 +224,7 @@ mod tests {
             drift_m: Some(speed / 10.0),
             max_tilt_rad: 0.0,
             actuators: None,
+            reaches_given_up: None,
         }
     }
 

@@ -24,8 +24,9 @@ use crate::observe::{Recorder, RecorderOutcome};
 pub(crate) struct WatchOptions<'a> {
     /// Record the walk (an observer beside walkd) to this MCAP file.
     pub record: Option<PathBuf>,
-    /// Record the dynamic gait's ZMP and DCM telemetry and the daemon's state changes.
-    pub balance: bool,
+    /// Record walkd's telemetry: the dynamic gait's ZMP and DCM, the daemon's state changes, the
+    /// planned phases and the hands in contact.
+    pub telemetry: bool,
     /// Keep recording this long after the walk ended (to see whether the robot stays up).
     pub linger: Duration,
     /// How long the walk may take before it counts as stuck.
@@ -65,12 +66,15 @@ pub(crate) struct WatchedWalk {
     /// Largest controller-vs-simulator CoM or sole distance (m) and the statuses it is the
     /// maximum over; `None` when no status paired with a simulator state.
     pub drift: Option<(f64, usize)>,
-    /// The ZMP and DCM telemetry, with [`WatchOptions::balance`].
+    /// The ZMP and DCM telemetry, with [`WatchOptions::telemetry`].
     pub balance: Vec<BalanceSample>,
-    /// The ticks at which the daemon's state changed, with [`WatchOptions::balance`].
+    /// The ticks at which the daemon's state changed, with [`WatchOptions::telemetry`].
     pub state_changes: Vec<StateChange>,
-    /// The dynamic gait's planned support phases, with [`WatchOptions::balance`].
+    /// The dynamic gait's planned support phases, with [`WatchOptions::telemetry`].
     pub(crate) phases: Vec<PlannedPhase>,
+    /// Per stance index, whether each hand was in walkd's contact set, with
+    /// [`WatchOptions::telemetry`] (`None` without).
+    pub hands_held: Option<Vec<[bool; 2]>>,
     /// The recording, with [`WatchOptions::record`].
     pub recording: Option<RecorderOutcome>,
 }
@@ -90,7 +94,7 @@ pub(crate) fn watch_walk(
         .transpose()?;
     let recorder = TruthRecorder::start(prefix)?;
     let balance = options
-        .balance
+        .telemetry
         .then(|| BalanceRecorder::start(prefix))
         .transpose()?;
     let start = client.status()?;
@@ -121,10 +125,15 @@ pub(crate) fn watch_walk(
     std::thread::sleep(options.linger);
     let recording = observer.map(Recorder::finish).transpose()?;
     let states = recorder.finish()?;
-    let (balance, state_changes, phases) = match balance {
+    let (balance, state_changes, phases, hands_held) = match balance {
         Some(recorder) => {
             let recorded = recorder.finish(start.ticks, start.rate_hz)?;
-            (recorded.samples, recorded.state_changes, recorded.phases)
+            (
+                recorded.samples,
+                recorded.state_changes,
+                recorded.phases,
+                Some(recorded.hands_held),
+            )
         }
         None => Default::default(),
     };
@@ -154,6 +163,7 @@ pub(crate) fn watch_walk(
         balance,
         state_changes,
         phases,
+        hands_held,
         recording,
     })
 }

@@ -211,6 +211,11 @@ pub(crate) struct StateMachine {
     /// (x, y, yaw) at release. Planar, so the pelvis roll of ARMAR-4's hip strategy does not
     /// swing them sideways.
     carried: [Option<Isometry3<f64>>; 4],
+    /// Hands whose reach timed out ([`StateMachine::give_up_reach`]): they stay free until the
+    /// sequence's contact run they were reaching for ends.
+    given_up: [bool; 4],
+    /// Reaches given up since the sequence was loaded.
+    reaches_given_up: u32,
     targets: Targets,
 }
 
@@ -240,6 +245,8 @@ impl StateMachine {
             free_targets: [None; 4],
             catch: None,
             carried: [None; 4],
+            given_up: [false; 4],
+            reaches_given_up: 0,
             targets: Targets::none(),
         }
     }
@@ -306,11 +313,18 @@ impl StateMachine {
         (self.stance, self.sequence.as_ref().map_or(0, |s| s.len()))
     }
 
+    /// Reaches given up since the sequence was loaded ([`StateMachine::give_up_reach`]).
+    pub fn reaches_given_up(&self) -> u32 {
+        self.reaches_given_up
+    }
+
     /// Installs a sequence to execute from the next update; returns the previous one.
     pub fn load(&mut self, sequence: Box<PreparedSequence>) -> Option<Box<PreparedSequence>> {
         self.started = false;
         self.catch = None;
         self.stance = 0;
+        self.given_up = [false; 4];
+        self.reaches_given_up = 0;
         self.sequence.replace(sequence)
     }
 
@@ -359,7 +373,8 @@ impl StateMachine {
     }
 
     /// One tick of the sequence: starts it on the first call after `load`, checks the current
-    /// phase's completion and timeout, advances, and refreshes the targets.
+    /// phase's completion and timeout (a reach that times out is given up, any other phase
+    /// faults), advances, and refreshes the targets.
     pub fn update(&mut self, feedback: &Feedback, dt: f64) -> Progress {
         if !self.started {
             self.begin(feedback);
@@ -370,17 +385,18 @@ impl StateMachine {
         loop {
             match self.check_step(feedback) {
                 StepStatus::Running => break,
+                StepStatus::TimedOut if self.current_step().phase == Phase::Reach => {
+                    self.give_up_reach(&feedback.pelvis);
+                }
                 StepStatus::TimedOut => {
                     return Progress::Fault(FaultCode::Timeout(self.current_step().phase));
                 }
-                StepStatus::Complete => {
-                    self.finish_step(feedback);
-                    if !self.advance(feedback) {
-                        self.refresh_targets(&feedback.pelvis);
-                        self.targets.contact_velocity = [[0.0; 6]; 2];
-                        return Progress::Done;
-                    }
-                }
+                StepStatus::Complete => self.finish_step(feedback),
+            }
+            if !self.advance(feedback) {
+                self.refresh_targets(&feedback.pelvis);
+                self.targets.contact_velocity = [[0.0; 6]; 2];
+                return Progress::Done;
             }
         }
         self.refresh_targets(&feedback.pelvis);
@@ -463,10 +479,15 @@ impl StateMachine {
     }
 
     fn begin_transition(&mut self, feedback: &Feedback) {
-        let next = self.sequence().stances[self.stance].contacts;
+        let mut next = self.sequence().stances[self.stance].contacts;
         let is_last = self.stance + 1 == self.sequence().len();
         for hand in EndEffector::HANDS {
             let h = hand as usize;
+            if !next[h] {
+                self.given_up[h] = false;
+            } else if self.given_up[h] {
+                next[h] = false;
+            }
             if !next[h] && self.targets.contacts[h] {
                 self.targets.contacts[h] = false;
                 if self.config.carry_released_hands {
@@ -597,8 +618,30 @@ impl StateMachine {
                 unreachable!("static plans hold no dynamic-gait phase")
             }
         };
-        // However far a target, a phase that does not complete faults in bounded time.
+        // However far a target, a phase that does not complete ends in bounded time: it faults,
+        // or a reach is given up.
         self.deadline = duration.min(c.max_phase_s) + timeout;
+    }
+
+    /// A hand that did not reach its contact within the reach's deadline: the walk goes on
+    /// without it. It never carried any of the weight (a hand counts as a support only once it
+    /// reached), so nothing the balance relies on is lost. It is let go as a released hand is: back
+    /// to where the reach started and carried with the pelvis (`carry_released_hands`), or left
+    /// to the posture task; it stays free until the contact run it reached for ends. A grasp the
+    /// arm cannot reach (the feet too far from the railing, a joint limit, the CoM constraint)
+    /// would otherwise stop the whole walk there.
+    fn give_up_reach(&mut self, pelvis: &Isometry3<f64>) {
+        let Some(hand) = self.current_step().end_effector else {
+            return;
+        };
+        let h = hand as usize;
+        let (start, _) = self.motion.sample(0.0);
+        self.carried[h] = self
+            .config
+            .carry_released_hands
+            .then(|| heading_frame(pelvis).inverse() * start);
+        self.given_up[h] = true;
+        self.reaches_given_up = self.reaches_given_up.saturating_add(1);
     }
 
     /// A motion from `start` to `goal` at the configured swing speeds.

@@ -830,6 +830,7 @@ impl Controller {
         self.status.left_foot = pose_array(&self.poses[EndEffector::LeftFoot as usize]);
         self.status.right_foot = pose_array(&self.poses[EndEffector::RightFoot as usize]);
         self.status.contacts = self.machine.targets().contacts;
+        self.status.reaches_given_up = self.machine.reaches_given_up();
         ok
     }
 

@@ -127,6 +127,11 @@ impl Sequencer {
         self.targets().foot_anchors()
     }
 
+    /// Hand reaches the static gait gave up in its walk (`StateMachine::give_up_reach`).
+    pub fn reaches_given_up(&self) -> u32 {
+        self.fallback.reaches_given_up()
+    }
+
     /// The railings of the running gait's sequence, in the world (`hand_clearance`).
     pub fn railings(&self) -> impl Iterator<Item = RailAxis> + Clone + '_ {
         let running = if self.dynamic_selected {

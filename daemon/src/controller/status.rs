@@ -144,7 +144,6 @@ impl FaultCode {
             Self::Timeout(Phase::Lift) => "timeout: foot lift did not reach its target",
             Self::Timeout(Phase::Swing) => "timeout: swing did not reach its target",
             Self::Timeout(Phase::Lower) => "timeout: touchdown never confirmed by force-torque",
-            Self::Timeout(Phase::Reach) => "timeout: hand did not reach its contact",
             Self::Timeout(Phase::Settle) => "timeout: CoM did not settle",
             Self::Timeout(_) => "timeout",
             Self::MissedTouchdown => "missed touchdown: force-torque never confirmed the landing",
@@ -172,7 +171,6 @@ impl FaultCode {
             Self::Timeout(Phase::Lift) => "timeout_lift",
             Self::Timeout(Phase::Swing) => "timeout_swing",
             Self::Timeout(Phase::Lower) => "timeout_lower",
-            Self::Timeout(Phase::Reach) => "timeout_reach",
             Self::Timeout(Phase::Settle) => "timeout_settle",
             Self::Timeout(_) => "timeout",
             Self::MissedTouchdown => "missed_touchdown",
@@ -293,6 +291,9 @@ pub struct ControllerStatus {
     pub fault: FaultCode,
     /// Duration of the current or last controlled stop (s; 0: none since the walk began).
     pub stop_s: f64,
+    /// Hand reaches the static gait gave up in this walk: a hand that did not reach its contact
+    /// in time stays free and the walk goes on without it (`StateMachine::give_up_reach`).
+    pub reaches_given_up: u32,
     /// Ticks since construction.
     pub ticks: u64,
     /// Iterations of the last QP solve.
