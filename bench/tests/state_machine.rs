@@ -419,13 +419,22 @@ fn the_base_roll_and_pitch_rates_keep_their_own_bound_through_a_walk() {
 /// The synthetic walk with the left hand, except that the hand lets go again after its first
 /// stance in contact and the feet walk on without it.
 fn walk_releasing_the_hand(h: &Harness) -> stance::PostProcessedSequence {
+    held_walk_edited(h, |stances, _| {
+        for stance in &mut stances[2..] {
+            stance.contacts[EndEffector::LeftHand as usize] = false;
+        }
+    })
+}
+
+/// The 4-step synthetic walk with the left hand held, its stances and targets changed by `edit`.
+fn held_walk_edited(
+    h: &Harness,
+    edit: impl FnOnce(&mut [stance::Stance], &mut [[nalgebra::Isometry3<f64>; 4]]),
+) -> stance::PostProcessedSequence {
     let held = walk_support::synthetic_walk(&h.robot, 4, 0.08, true);
-    let left_hand = EndEffector::LeftHand as usize;
     let mut stances = held.stances().to_vec();
-    for stance in &mut stances[2..] {
-        stance.contacts[left_hand] = false;
-    }
-    let targets = (0..held.len()).map(|i| *held.targets(i)).collect();
+    let mut targets: Vec<_> = (0..held.len()).map(|i| *held.targets(i)).collect();
+    edit(&mut stances, &mut targets);
     stance::PostProcessedSequence::new(
         held.robot().to_owned(),
         held.joint_names().to_vec(),
@@ -484,22 +493,14 @@ fn a_released_hand_is_carried_with_the_pelvis_only_when_configured() {
 /// The synthetic walk with the left hand held from its second stance on, at a grasp 0.6 m
 /// further out than the standing posture puts it: beyond the arm's reach.
 fn walk_reaching_too_far(h: &Harness) -> stance::PostProcessedSequence {
-    let held = walk_support::synthetic_walk(&h.robot, 4, 0.08, true);
-    let left_hand = EndEffector::LeftHand as usize;
-    let mut targets: Vec<_> = (0..held.len()).map(|i| *held.targets(i)).collect();
-    for (stance, target) in held.stances().iter().zip(&mut targets) {
-        if stance.contacts[left_hand] {
-            target[left_hand].translation.vector.y += 0.6;
+    held_walk_edited(h, |stances, targets| {
+        let left_hand = EndEffector::LeftHand as usize;
+        for (stance, target) in stances.iter().zip(targets) {
+            if stance.contacts[left_hand] {
+                target[left_hand].translation.vector.y += 0.6;
+            }
         }
-    }
-    stance::PostProcessedSequence::new(
-        held.robot().to_owned(),
-        held.joint_names().to_vec(),
-        held.environment().clone(),
-        held.stances().to_vec(),
-        targets,
-    )
-    .unwrap()
+    })
 }
 
 #[test]

@@ -23,7 +23,6 @@
 //! ([`write_fig6`] is shared with the in-process physics walk of the `walk-tests` package).
 
 pub mod actuators;
-pub(crate) mod balance;
 pub(crate) mod clearance;
 pub mod fig6;
 pub mod filmstrip;
@@ -31,6 +30,7 @@ pub mod footholds;
 pub(crate) mod hands;
 pub mod record;
 pub mod stop;
+pub(crate) mod telemetry;
 pub mod timing;
 pub(crate) mod truth;
 pub(crate) mod watch;

@@ -14,7 +14,7 @@ use kinematics::ConfigFile;
 use shm_types::process::InjectedFault;
 use shm_types::{DaemonState, SimTruth};
 
-use super::balance::StateChange;
+use super::telemetry::StateChange;
 use super::truth::state_at;
 use super::watch::WatchedWalk;
 

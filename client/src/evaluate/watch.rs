@@ -12,7 +12,7 @@ use nalgebra::Isometry3;
 use shm_types::{DaemonStatus, SimTruth};
 use stance::PostProcessedSequence;
 
-use super::balance::{BalanceRecorder, StateChange};
+use super::telemetry::{StateChange, TelemetryRecorder};
 use super::timing::PlannedPhase;
 use super::truth::{TruthRecorder, Verdict, state_at};
 use super::{BalanceSample, Points, TraceSample, align_targets};
@@ -93,9 +93,9 @@ pub(crate) fn watch_walk(
         .map(|file| Recorder::start(prefix, Arc::clone(robot), file))
         .transpose()?;
     let recorder = TruthRecorder::start(prefix)?;
-    let balance = options
+    let telemetry = options
         .telemetry
-        .then(|| BalanceRecorder::start(prefix))
+        .then(|| TelemetryRecorder::start(prefix))
         .transpose()?;
     let start = client.status()?;
     let mut targets = super::stance_points(robot, sequence);
@@ -125,7 +125,7 @@ pub(crate) fn watch_walk(
     std::thread::sleep(options.linger);
     let recording = observer.map(Recorder::finish).transpose()?;
     let states = recorder.finish()?;
-    let (balance, state_changes, phases, hands_held) = match balance {
+    let (balance, state_changes, phases, hands_held) = match telemetry {
         Some(recorder) => {
             let recorded = recorder.finish(start.ticks, start.rate_hz)?;
             (

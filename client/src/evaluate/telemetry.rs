@@ -1,5 +1,5 @@
-//! The balance of a dynamic walk over the real processes: walkd's per-tick telemetry
-//! (`<prefix>/telemetry`, read by the observer's [`Source`]) kept on a thread of its own, every
+//! What `walkctl evaluate` keeps of walkd's per-tick telemetry over the real processes
+//! (`<prefix>/telemetry`, read by the observer's [`Source`]), on a thread of its own: every
 //! [`KEEP_EVERY`]th tick that carries ZMP and DCM, for the balance row of Fig. 6, every tick
 //! at which the daemon's state changed (to time a controlled stop to the tick), every planned
 //! support phase the dynamic gait entered ([`super::timing`]), and the stances in which each hand
@@ -45,7 +45,7 @@ struct Kept {
 }
 
 /// What a walk's telemetry showed, from the tick it started.
-pub(crate) struct RecordedBalance {
+pub(crate) struct RecordedTelemetry {
     /// ZMP and DCM, for Fig. 6.
     pub samples: Vec<BalanceSample>,
     /// The daemon's state changes.
@@ -57,31 +57,31 @@ pub(crate) struct RecordedBalance {
     pub hands_held: Vec<[bool; 2]>,
 }
 
-/// The ticks and ZMP/DCM of a walk's telemetry, until [`BalanceRecorder::finish`].
-pub(crate) struct BalanceRecorder {
+/// The ticks and ZMP/DCM of a walk's telemetry, until [`TelemetryRecorder::finish`].
+pub(crate) struct TelemetryRecorder {
     source: Source,
     collector: JoinHandle<Kept>,
 }
 
-impl BalanceRecorder {
+impl TelemetryRecorder {
     /// Subscribes to the daemon on `prefix`; returns once subscribed.
     pub(crate) fn start(prefix: &str) -> anyhow::Result<Self> {
         let (source, batches) = Source::start(prefix)?;
         let collector = std::thread::Builder::new()
-            .name("evaluate-balance".to_owned())
+            .name("evaluate-telemetry".to_owned())
             .spawn(move || collect(&batches))
-            .context("starting the balance recorder")?;
+            .context("starting the telemetry recorder")?;
         Ok(Self { source, collector })
     }
 
     /// Stops recording; the samples from tick `start_tick` on at `rate_hz`, time from there,
     /// the state changes from that tick on, and the planned phases.
-    pub(crate) fn finish(self, start_tick: u64, rate_hz: f64) -> anyhow::Result<RecordedBalance> {
+    pub(crate) fn finish(self, start_tick: u64, rate_hz: f64) -> anyhow::Result<RecordedTelemetry> {
         self.source.stop()?;
         let kept = self
             .collector
             .join()
-            .map_err(|_| anyhow::anyhow!("the balance recorder panicked"))?;
+            .map_err(|_| anyhow::anyhow!("the telemetry recorder panicked"))?;
         let balance = kept
             .balance
             .iter()
@@ -99,7 +99,7 @@ impl BalanceRecorder {
             .into_iter()
             .filter(|c| c.tick >= start_tick)
             .collect();
-        Ok(RecordedBalance {
+        Ok(RecordedTelemetry {
             samples: balance,
             state_changes: changes,
             phases: kept.phases,
