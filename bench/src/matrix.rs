@@ -108,6 +108,11 @@ pub struct MatrixRun {
     pub dcm_rms_m: f64,
     /// Controller tick wall time: median, 99th percentile, largest (µs).
     pub tick_us: [f64; 3],
+    /// The held hands' share of the weight (`PhysicsWalkReport::hand_support_share`).
+    pub hand_support_share: Option<f64>,
+    /// How far the CoM stood outside the soles for a second (`PhysicsWalkReport::
+    /// com_outside_feet_m`).
+    pub com_outside_feet_m: f64,
 }
 
 impl MatrixRun {
@@ -134,6 +139,8 @@ impl MatrixRun {
                 zmp_rms_m: 0.0,
                 dcm_rms_m: 0.0,
                 tick_us: [0.0; 3],
+                hand_support_share: None,
+                com_outside_feet_m: 0.0,
             },
             Ok(report) => Self {
                 record: WalkRecord {
@@ -152,6 +159,8 @@ impl MatrixRun {
                 zmp_rms_m: report.balance.zmp_rms_m,
                 dcm_rms_m: report.balance.dcm_rms_m,
                 tick_us: report.tick_us,
+                hand_support_share: report.hand_support_share,
+                com_outside_feet_m: report.com_outside_feet_m,
             },
         }
     }
@@ -373,7 +382,7 @@ fn run_line(run: &MatrixRun) -> String {
     }
     format!(
         "{} {} m seed {}: {}{} after {} stances, {:.3} m in {:.2} s, {}, drift {:.3} m, tilt \
-         {:.3} rad, ZMP rms {:.3} m, DCM rms {:.3} m, tick p50 {:.1} p99 {:.1} µs",
+         {:.3} rad, ZMP rms {:.3} m, DCM rms {:.3} m, tick p50 {:.1} p99 {:.1} µs{}",
         r.affordances,
         r.distance_m,
         r.seed,
@@ -390,6 +399,11 @@ fn run_line(run: &MatrixRun) -> String {
         run.dcm_rms_m,
         run.tick_us[0],
         run.tick_us[1],
+        run.hand_support_share
+            .map_or_else(String::new, |share| format!(
+                ", hand share {share:.3}, CoM outside the soles {:.3} m for 1 s",
+                run.com_outside_feet_m
+            )),
     )
 }
 
@@ -423,6 +437,23 @@ fn print_table(report: &MatrixReport) {
         );
         if let Some(actuators) = &g.actuators {
             println!("{:<16} peak {}", "", actuators.describe());
+        }
+        let shares: Vec<f64> = report
+            .runs
+            .iter()
+            .filter(|run| {
+                run.record.affordances == g.affordances && run.record.distance_m == g.distance_m
+            })
+            .filter_map(|run| run.hand_support_share)
+            .collect();
+        if !shares.is_empty() {
+            println!(
+                "{:<16} hand share mean {:.3}, min {:.3}, max {:.3}",
+                "",
+                shares.iter().sum::<f64>() / shares.len() as f64,
+                shares.iter().copied().fold(f64::INFINITY, f64::min),
+                shares.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            );
         }
     }
     println!("{} of {} runs done", report.done, report.runs.len());

@@ -21,14 +21,15 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use client::evaluate::actuators::ActuatorReport;
+use client::evaluate::hands::hand_planned_held;
 use client::evaluate::{Points, TraceSample, align_targets, stance_points};
 use daemon::controller::{
     BalanceStatus, Controller, ControllerConfig, ControllerState, ControllerStatus,
     DynamicGaitConfig, FaultCode, Gait, GaitConfig, Phase, SolverKind,
 };
 use kinematics::ConfigFile;
-use kinematics::ground::GRAVITY;
-use kinematics::robot::{EndEffector, Robot};
+use kinematics::ground::{GRAVITY, SupportPolygon, sole_corners};
+use kinematics::robot::{EndEffector, Robot, SoleRectangle};
 use nalgebra::{Isometry3, Vector2, Vector3};
 use sim_adapter::MotorLoad;
 use sim_adapter::mujoco::{MujocoError, MujocoOptions, MujocoSim, Terrain};
@@ -197,6 +198,15 @@ pub struct PhysicsWalkReport {
     /// How hard the walk worked the motors against the URDF's limits (the whole run, settle
     /// time included).
     pub actuators: ActuatorReport,
+    /// The held hands' mean vertical force (at the wrists, as the simulator measures it) over
+    /// the robot's weight, over the ticks a hand is planned to carry
+    /// (`client::evaluate::hands::hand_planned_held`); `None` when none is: what `walkctl
+    /// evaluate` reports as `hand_support_share`.
+    pub hand_support_share: Option<f64>,
+    /// The farthest the simulator's CoM stood outside the polygon of the soles the controller
+    /// had in contact for [`COM_OUTSIDE_HELD_S`] without a break (m; 0 if never): a robot
+    /// leaning on a held hand stands where its feet alone would not hold it.
+    pub com_outside_feet_m: f64,
     /// Simulated time the [`PhysicsWalkOptions::push`] began (s): `None` without a push, or
     /// when the walk ended before its single support, so that a push sweep cannot count a walk
     /// that was never pushed as surviving.
@@ -218,6 +228,8 @@ pub struct BalanceSample {
     pub com_true: [f64; 3],
     /// Normal force on each foot (left, right; N).
     pub foot_forces: [f64; 2],
+    /// Force on each hand at its wrist (left, right; N, world axes).
+    pub hand_forces: [[f64; 3]; 2],
 }
 
 /// How closely a dynamic walk's ZMP and DCM followed the walking pattern (m), over the executing
@@ -366,6 +378,10 @@ pub fn walk_sequence(
         first_step_s: None,
         push,
         balance: BalanceAccumulator::default(),
+        contacts: (0..sequence.len()).map(|i| sequence.contacts(i)).collect(),
+        hand_support: HandSupportSum::default(),
+        sole: robot.sole,
+        com_outside: Vec::with_capacity(max_ticks.min(1 << 22) as usize),
     };
     let wall = Instant::now();
     let mut ticks = 0u64;
@@ -398,6 +414,7 @@ pub fn walk_sequence(
                 com_estimated: status.com,
                 com_true: m.com.into(),
                 foot_forces: [m.wrenches[0][2], m.wrenches[1][2]],
+                hand_forces: [2, 3].map(|h| [0, 1, 2].map(|k| m.wrenches[h][k])),
             });
         }
         if sim.has_fallen() {
@@ -463,6 +480,13 @@ pub fn walk_sequence(
         balance: loop_state.balance.tracking(),
         balance_trace: loop_state.balance_trace,
         pushed_at_s: loop_state.push.and_then(|push| push.applied_at),
+        hand_support_share: loop_state
+            .hand_support
+            .share(robot.model.total_mass() * GRAVITY),
+        com_outside_feet_m: held_for(
+            &loop_state.com_outside,
+            (COM_OUTSIDE_HELD_S * options.rate_hz).round() as usize,
+        ),
         actuators: ActuatorReport::new(&sim.actuator_load(), &robot),
     })
 }
@@ -614,6 +638,52 @@ struct LoopState {
     first_step_s: Option<f64>,
     push: Option<PushSchedule>,
     balance: BalanceAccumulator,
+    /// The sequence's contact flags per stance.
+    contacts: Vec<[bool; 4]>,
+    hand_support: HandSupportSum,
+    sole: SoleRectangle,
+    /// How far the simulator's CoM stood outside the soles in contact, each tick (m; negative
+    /// inside).
+    com_outside: Vec<f64>,
+}
+
+/// How long (s) [`PhysicsWalkReport::com_outside_feet_m`] asks the CoM to stay outside.
+pub const COM_OUTSIDE_HELD_S: f64 = 1.0;
+
+/// The largest value that `values` stays at or above for `window` consecutive entries (0 when
+/// none does, or it never is positive): the sliding-window minimum's maximum.
+fn held_for(values: &[f64], window: usize) -> f64 {
+    let window = window.max(1);
+    let mut best = 0.0_f64;
+    // Indices of a window's candidates for its minimum, their values increasing.
+    let mut candidates = std::collections::VecDeque::new();
+    for (i, &value) in values.iter().enumerate() {
+        while candidates.back().is_some_and(|&j| values[j] >= value) {
+            candidates.pop_back();
+        }
+        candidates.push_back(i);
+        if candidates.front().is_some_and(|&j| j + window <= i) {
+            candidates.pop_front();
+        }
+        if i + 1 >= window {
+            best = best.max(values[candidates[0]]);
+        }
+    }
+    best
+}
+
+/// The hands' vertical force summed over the ticks a hand is planned to carry.
+#[derive(Default)]
+struct HandSupportSum {
+    newtons: f64,
+    ticks: u64,
+}
+
+impl HandSupportSum {
+    /// The mean over the robot's weight `weight_n` (N); `None` without a tick.
+    fn share(&self, weight_n: f64) -> Option<f64> {
+        (self.ticks > 0).then(|| self.newtons / self.ticks as f64 / weight_n)
+    }
 }
 
 impl LoopState {
@@ -659,6 +729,29 @@ impl LoopState {
 
     /// Drift and fall indicators of the state after a tick.
     fn observe(&mut self, sim: &MujocoSim, status: &ControllerStatus) {
+        let mut corners = [[0.0; 2]; 8];
+        let mut count = 0;
+        for foot in FEET.into_iter().filter(|f| status.contacts[*f as usize]) {
+            for corner in sole_corners(&sim.end_effector_pose(foot), &self.sole) {
+                corners[count] = [corner.x, corner.y];
+                count += 1;
+            }
+        }
+        let com = sim.measurement().com;
+        let feet = SupportPolygon::from_points(&corners[..count]);
+        // No sole in contact counts as inside: there is no polygon to be outside of.
+        let outside = -feet.signed_distance([com.x, com.y]);
+        self.com_outside.push(if count == 0 {
+            f64::NEG_INFINITY
+        } else {
+            outside
+        });
+        if hand_planned_held(&self.contacts, status.stance_index as usize) {
+            let wrenches = &sim.measurement().wrenches;
+            let hands = EndEffector::HANDS.iter().map(|&h| wrenches[h as usize][2]);
+            self.hand_support.newtons += hands.sum::<f64>();
+            self.hand_support.ticks += 1;
+        }
         let controller = controller_points(status).transformed(&self.controller_frame);
         let (com, feet) = sim_points(sim).distances(&controller);
         self.max_com_drift = self.max_com_drift.max(com);
@@ -682,5 +775,22 @@ fn sim_points(sim: &MujocoSim) -> Points {
             .end_effector_pose(EndEffector::RightFoot)
             .translation
             .vector,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::held_for;
+
+    #[test]
+    fn a_distance_counts_only_as_far_as_it_was_held_for_the_whole_window() {
+        // 5 cm for 3 ticks, 2 cm around them for 6: over 3 ticks 5 cm, over 5 ticks 2 cm.
+        let values = [0.0, 0.02, 0.05, 0.05, 0.05, 0.02, 0.02, -0.01, 0.1];
+        assert_eq!(held_for(&values, 3), 0.05);
+        assert_eq!(held_for(&values, 5), 0.02);
+        assert_eq!(held_for(&values, 1), 0.1);
+        // Never outside, or too short a walk for the window: 0.
+        assert_eq!(held_for(&[-0.1, -0.2], 1), 0.0);
+        assert_eq!(held_for(&[0.1, 0.1], 3), 0.0);
     }
 }

@@ -220,8 +220,14 @@ mod walks {
     /// hands kept clear of railings (`hand_clearance_m`), the hanging right palm swung out under
     /// the rail and was held down (dynamic: fell 0.34 m along), and a hand let go on top of it
     /// was pressed into it (static: fell 0.13 m along).
+    ///
+    /// The held hand carries weight (`hand_support_share`, 0.16 of it asked): the simulator's
+    /// wrist forces average at least 0.15 of the weight while the hand is planned to carry, and
+    /// leaning on it the robot stands with its CoM at least 3 cm outside its soles for a second
+    /// (the single supports on its left foot, away from the rail). Before the balance counted
+    /// the hand (a 10 N touch) the share was 0.017 and the CoM never left the soles.
     #[test]
-    fn jvrc1_walks_beside_a_railing_free_hands_clear_of_it() {
+    fn jvrc1_walks_beside_a_railing_leaning_on_its_held_hand() {
         let file =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/scenes/railing.toml");
         let scene = std::sync::Arc::new(stance::Scene::from_path(&file).expect("scene loads"));
@@ -250,6 +256,16 @@ mod walks {
                 report.sim_s,
                 report.distance_m
             );
+            if affordances == AffordanceSet::FeetRightHand {
+                let share = report.hand_support_share.expect("a hand planned to carry");
+                let outside = report.com_outside_feet_m;
+                println!("{label}: hand share {share:.3}, CoM {outside:.3} m outside for 1 s");
+                assert!(share >= 0.15, "{label}: the hand carried {share:.3}");
+                assert!(
+                    outside >= 0.03,
+                    "{label}: the CoM left the soles by {outside:.3} m"
+                );
+            }
         }
     }
 

@@ -27,7 +27,7 @@ pub(crate) mod clearance;
 pub mod fig6;
 pub mod filmstrip;
 pub mod footholds;
-pub(crate) mod hands;
+pub mod hands;
 pub mod record;
 pub mod stop;
 pub(crate) mod telemetry;

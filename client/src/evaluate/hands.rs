@@ -19,19 +19,9 @@ pub(crate) fn support_share(
     states: &[SimTruth],
     weight_n: f64,
 ) -> Option<f64> {
-    let last = contacts.len().checked_sub(1)?;
-    let held = |i: usize| {
-        let (now, before) = (
-            contacts[i.min(last)],
-            contacts[i.saturating_sub(1).min(last)],
-        );
-        EndEffector::HANDS
-            .iter()
-            .any(|&h| now[h as usize] && before[h as usize])
-    };
     let (mut sum, mut count) = (0.0, 0_usize);
     for (index, time) in statuses {
-        if !held(index as usize) {
+        if !hand_planned_held(contacts, index as usize) {
             continue;
         }
         let Some(state) = state_at(states, time) else {
@@ -41,6 +31,23 @@ pub(crate) fn support_share(
         count += 1;
     }
     (count > 0).then(|| sum / count as f64 / weight_n)
+}
+
+/// Whether a hand is planned to carry while the walk moves towards stance `index` of `contacts`
+/// (the sequence's flags per stance): that stance holds it and the one before held it too, so a
+/// hand reaching for the rail is not yet meant to carry. An index past the end is the last
+/// stance; false without stances.
+pub fn hand_planned_held(contacts: &[[bool; 4]], index: usize) -> bool {
+    let Some(last) = contacts.len().checked_sub(1) else {
+        return false;
+    };
+    let (now, before) = (
+        contacts[index.min(last)],
+        contacts[index.saturating_sub(1).min(last)],
+    );
+    EndEffector::HANDS
+        .iter()
+        .any(|&h| now[h as usize] && before[h as usize])
 }
 
 /// The planned hand contact runs (a hand in contact through consecutive stances of `contacts`,

@@ -57,6 +57,11 @@ pub(crate) struct QpAssembler {
     torso_joints: Vec<bool>,
     /// Whether each joint belongs to `[robot.joint_groups] legs`.
     leg_joints: Vec<bool>,
+    /// Whether each joint moves each hand (left, right) and is no torso joint: its arm.
+    arm_joints: [Vec<bool>; 2],
+    /// The base's yaw (relative to the standing orientation) when a hand began to carry weight,
+    /// kept while one does.
+    held_yaw: Option<f64>,
 }
 
 impl QpAssembler {
@@ -87,6 +92,14 @@ impl QpAssembler {
                 }
             }
         }
+        let torso_joints: Vec<bool> = (0..model.dof())
+            .map(|j| robot.joint_groups.torso.contains(&j))
+            .collect();
+        let arm_joints = EndEffector::HANDS.map(|hand| {
+            (0..model.dof())
+                .map(|j| nonzero[hand as usize][6 + j] && !torso_joints[j])
+                .collect()
+        });
         let columns = nonzero.map(|flags| {
             flags
                 .iter()
@@ -104,12 +117,12 @@ impl QpAssembler {
             upright_reference: robot.standing.base.rotation,
             polygon: SupportPolygon::empty(),
             corners: [[0.0; 2]; MAX_SUPPORT_POINTS],
-            torso_joints: (0..model.dof())
-                .map(|j| robot.joint_groups.torso.contains(&j))
-                .collect(),
+            torso_joints,
             leg_joints: (0..model.dof())
                 .map(|j| robot.joint_groups.legs.contains(&j))
                 .collect(),
+            arm_joints,
+            held_yaw: None,
         }
     }
 
@@ -165,9 +178,12 @@ impl QpAssembler {
         };
         let (com_rows, height, height_velocity) =
             held.map_or((2, com.z, 0.0), |held| (3, held.height, held.velocity));
+        // The set-point is where the feet's load is centred; the hands' load moves the CoM's.
+        let com_target = targets.hand_load.com_of(targets.com);
+        let com_feed_forward = targets.hand_load.com_velocity_of(targets.com_velocity);
         let com_velocity = [
-            targets.com_velocity.x + config.com_gain * (targets.com.x - com.x),
-            targets.com_velocity.y + config.com_gain * (targets.com.y - com.y),
+            com_feed_forward.x + config.com_gain * (com_target.x - com.x),
+            com_feed_forward.y + config.com_gain * (com_target.y - com.y),
             height_velocity + config.com_gain * (height - com.z),
         ];
         add_task(
@@ -207,11 +223,19 @@ impl QpAssembler {
             );
         }
 
-        // Upright base: no roll or pitch relative to the standing orientation, yaw left free.
+        // Upright base: no roll or pitch relative to the standing orientation, yaw left free,
+        // except while a hand carries weight: then the base keeps the yaw it had when it began to.
+        // Leaning on a held hand, JVRC-1's QP twisted the pelvis 0.36 rad towards the rail (hip
+        // yaw is cheap under the legs' weak posture task), and untwisting it when the hand let go
+        // rocked the robot from foot to foot until it fell.
         // The base Jacobian's angular rows are the identity on ω.
         let relative = configuration.base.rotation * self.upright_reference.inverse();
         let (_, _, yaw) = relative.euler_angles();
-        let upright = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw);
+        let leaning = EndEffector::HANDS
+            .iter()
+            .any(|hand| targets.hand_load.carries(*hand));
+        self.held_yaw = leaning.then(|| self.held_yaw.unwrap_or(yaw));
+        let upright = UnitQuaternion::from_euler_angles(0.0, 0.0, self.held_yaw.unwrap_or(yaw));
         let tilt = (upright * relative.inverse()).scaled_axis();
         for k in 0..3 {
             p[(3 + k, 3 + k)] += config.torso_weight;
@@ -219,14 +243,21 @@ impl QpAssembler {
         }
 
         // Posture: the stance's, the legs' standing one, and the torso joints at their own
-        // weight when the gait asks for it.
+        // weight when the gait asks for it. The arm of a hand that carries weight is not driven
+        // through the pose task's null space (its reference is where it is): the next stance's
+        // arm posture swung JVRC-1's wrist at 0.4 rad/s while its palm leant on a rail with 130 N,
+        // and the palm came off it.
+        let held = EndEffector::HANDS.map(|hand| targets.hand_load.carries(hand));
         for j in 0..model.dof() {
             let weight = match targets.torso_posture_weight {
                 Some(weight) if self.torso_joints[j] => weight,
                 _ => config.posture_weight,
             };
+            let holding = (0..2).any(|h| held[h] && self.arm_joints[h][j]);
             let reference = if self.leg_joints[j] {
                 robot.standing.joints[j]
+            } else if holding {
+                configuration.joints[j]
             } else {
                 posture[j]
             };
@@ -310,7 +341,8 @@ impl QpAssembler {
         }
     }
 
-    /// Hull of the sole corners of the feet in contact (at their anchors).
+    /// Hull of the sole corners of the feet in contact (at their anchors), as the CoM's: moved
+    /// towards the held hands by the share of the weight they carry (`hand_support`).
     fn polygon_from_contacts(&mut self, robot: &Robot, targets: &Targets) {
         let mut count = 0;
         for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
@@ -318,6 +350,7 @@ impl QpAssembler {
                 continue;
             }
             for corner in sole_corners(&targets.anchors[foot as usize], &robot.sole) {
+                let corner = targets.hand_load.com_of(corner.xy());
                 self.corners[count] = [corner.x, corner.y];
                 count += 1;
             }
@@ -382,22 +415,34 @@ mod tests {
     use std::path::Path;
 
     use super::*;
+    use crate::controller::hand_support::HandSupport;
     use crate::controller::machine::StateMachine;
     use kinematics::robot::SoleRectangle;
 
-    /// The linear term of the QP at the standing posture, with `posture` as the stance's `q_S`.
+    /// The linear term of the QP at the standing posture, with `posture` as the stance's `q_S`,
+    /// before a walk (no contact, no task).
     fn linear_term(
         robot: &Robot,
         config: &ControllerConfig,
         posture: &DVector<f64>,
     ) -> DVector<f64> {
-        let mut kinematics = Kinematics::new(&robot.model);
-        kinematics.update(&robot.model, &robot.standing);
         let sole = SoleRectangle {
             length: 0.2,
             width: 0.08,
         };
         let machine = StateMachine::new(config, sole, 600.0);
+        linear_term_with(robot, config, posture, machine.targets())
+    }
+
+    /// [`linear_term`] with `targets`.
+    fn linear_term_with(
+        robot: &Robot,
+        config: &ControllerConfig,
+        posture: &DVector<f64>,
+        targets: &Targets,
+    ) -> DVector<f64> {
+        let mut kinematics = Kinematics::new(&robot.model);
+        kinematics.update(&robot.model, &robot.standing);
         let mut assembler = QpAssembler::new(robot);
         assembler.assemble(
             robot,
@@ -405,7 +450,7 @@ mod tests {
             &kinematics,
             &robot.standing,
             &robot.standing.joints,
-            machine.targets(),
+            targets,
             posture,
             0.002,
         );
@@ -441,6 +486,42 @@ mod tests {
         assert!(
             (a[6 + elbow] - b[6 + elbow]).abs() > 1e-4,
             "the stance's elbow angle does not pull the elbow"
+        );
+    }
+
+    #[test]
+    fn the_arm_of_a_hand_that_carries_weight_keeps_where_it_is() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/jvrc1.toml");
+        let robot = Robot::load(&path, None).expect("the JVRC-1 config loads");
+        let config = ControllerConfig::from_config_file(&path).expect("its [controller] loads");
+        let joint = |name| robot.model.joint_index(name).expect("a JVRC-1 joint");
+        let (right_elbow, left_elbow) = (joint("R_ELBOW_P"), joint("L_ELBOW_P"));
+        let standing = robot.standing.joints.clone();
+        let mut bent = standing.clone();
+        bent[right_elbow] -= 0.5;
+        bent[left_elbow] -= 0.5;
+        // The right hand held and measured carrying 100 N.
+        let mut targets = Targets::none();
+        targets.contacts = [true, true, false, true];
+        let mut support = HandSupport::default();
+        for _ in 0..1000 {
+            support.update(&targets.contacts, None, &config, 600.0, 0.01);
+            support.sense(&[250.0, 250.0, 0.0, 100.0], 0.01);
+        }
+        targets.hand_load = support.load(&targets.anchors, 600.0);
+        assert!(targets.hand_load.carries(EndEffector::RightHand));
+        let (a, b) = (
+            linear_term_with(&robot, &config, &standing, &targets),
+            linear_term_with(&robot, &config, &bent, &targets),
+        );
+        assert_eq!(
+            a[6 + right_elbow],
+            b[6 + right_elbow],
+            "the stance's elbow angle pulls the carrying arm"
+        );
+        assert!(
+            (a[6 + left_elbow] - b[6 + left_elbow]).abs() > 1e-4,
+            "the free arm no longer follows the stance"
         );
     }
 }

@@ -159,6 +159,17 @@ pub struct ControllerConfig {
     /// Farthest the admittance moves a held hand's target from its planned pose, either way (m):
     /// a hand that finds no support sinks this far at most.
     pub hand_press_depth_m: f64,
+    /// Farthest the admittance moves a held hand's target sideways (m): the arm gives way to a
+    /// body leaning over its hand instead of pushing it back through the grasp, which on a round
+    /// rail slides the palm off it.
+    pub hand_press_slide_m: f64,
+    /// The share of the robot's weight each held hand is asked to carry in the static gait
+    /// (`hand_support`): the CoM may lean that far towards the railing, out of the feet's
+    /// polygon. The touch (`hand_force_n`) when smaller; 0 keeps the hands a touch.
+    pub hand_support_share: f64,
+    /// How fast a held hand's force asked rises to its share and falls back before it lets go
+    /// (shares of the weight per second).
+    pub hand_support_rate: f64,
     /// A joint measured this far beyond its URDF limits is an invalid measurement (an encoder
     /// or calibration fault): the controller faults, naming the joint (rad).
     pub joint_limit_tolerance_rad: f64,
@@ -241,6 +252,9 @@ impl Default for ControllerConfig {
             hand_admittance: 5e-4,
             hand_press_speed: 0.05,
             hand_press_depth_m: 0.01,
+            hand_press_slide_m: 0.1,
+            hand_support_share: 0.16,
+            hand_support_rate: 0.1,
             joint_limit_tolerance_rad: 0.03,
             workspace_radius_m: 100.0,
             workspace_depth_m: 3.0,
@@ -450,6 +464,9 @@ impl ControllerConfig {
             Bound::new("hand_admittance", self.hand_admittance, 0.0, 0.01),
             Bound::new("hand_press_speed", self.hand_press_speed, 0.0, 1.0),
             Bound::new("hand_press_depth_m", self.hand_press_depth_m, 0.0, 0.2),
+            Bound::new("hand_press_slide_m", self.hand_press_slide_m, 0.0, 0.3),
+            Bound::new("hand_support_share", self.hand_support_share, 0.0, 0.45),
+            Bound::new("hand_support_rate", self.hand_support_rate, 0.01, 10.0),
             Bound::new(
                 "joint_limit_tolerance_rad",
                 self.joint_limit_tolerance_rad,

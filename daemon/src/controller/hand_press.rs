@@ -7,29 +7,32 @@
 //! moved along the vertical by an offset `o` that integrates the force error,
 //!
 //! ```text
-//! ȯ = hand_admittance · (f_z − hand_force_n),  |ȯ| ≤ hand_press_speed,  |o| ≤ hand_press_depth_m,
+//! ȯ = hand_admittance · (f_z − f_d),  |ȯ| ≤ hand_press_speed,  |o| ≤ hand_press_depth_m,
 //! ```
 //!
 //! with `f_z` the vertical force of the environment on the hand measured at its wrist (upward
-//! positive): pressing harder than asked raises the target, softer lowers it. A hand that finds
+//! positive) and `f_d` the force asked of it (`Targets::hand_forces`: the static gait's share of
+//! the weight, `hand_support`; never less than the touch, `hand_force_n`): pressing harder than
+//! asked raises the target, softer lowers it. A hand that finds
 //! nothing sinks `hand_press_depth_m` below its planned pose at most and presses on nothing, so
 //! the walk goes on without it. The offset of a hand that is not held returns to zero at once.
 //!
 //! Pure and allocation-free: the controller applies it to each tick's targets just before the QP.
 
 use kinematics::robot::EndEffector;
+use nalgebra::Vector3;
 
 use super::config::ControllerConfig;
 use super::machine::Targets;
 
-/// The held hands' vertical target offsets (see the module docs).
+/// The held hands' target offsets (m, world; see the module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct HandPress {
-    offsets: [f64; 2],
+    offsets: [Vector3<f64>; 2],
 }
 
 impl HandPress {
-    /// Advances each held hand's offset by `dt` from its wrist's vertical force in `wrenches`
+    /// Advances each held hand's offset by `dt` from its wrist's force in `wrenches`
     /// (`EndEffector` order) and moves its pose task in `targets` by it; a hand without a held
     /// pose task (free, reaching, carried) gets no offset.
     pub fn apply(
@@ -43,20 +46,30 @@ impl HandPress {
             let h = hand as usize;
             let (true, Some(task)) = (targets.contacts[h], targets.end_effectors[h].as_mut())
             else {
-                *offset = 0.0;
+                *offset = Vector3::zeros();
                 continue;
             };
-            let speed = config.hand_admittance * (wrenches[h][2] - config.hand_force_n);
-            let step = speed.clamp(-config.hand_press_speed, config.hand_press_speed) * dt;
+            let asked = targets.hand_forces[h - EndEffector::LeftHand as usize];
+            let wanted = Vector3::new(0.0, 0.0, asked.max(config.hand_force_n));
+            let force = Vector3::new(wrenches[h][0], wrenches[h][1], wrenches[h][2]);
+            let speed = config.hand_press_speed;
+            let step = (config.hand_admittance * (force - wanted)).map(|v| v.clamp(-speed, speed));
+            *offset += step * dt;
             let depth = config.hand_press_depth_m;
-            *offset = (*offset + step).clamp(-depth, depth);
-            task.pose.translation.vector.z += *offset;
+            offset.z = offset.z.clamp(-depth, depth);
+            let slide = offset.xy().norm();
+            if slide > config.hand_press_slide_m {
+                let scale = config.hand_press_slide_m / slide;
+                offset.x *= scale;
+                offset.y *= scale;
+            }
+            task.pose.translation.vector += *offset;
         }
     }
 
     /// The current offsets (m; left hand, right hand).
     #[cfg(test)]
-    pub fn offsets(&self) -> [f64; 2] {
+    pub fn offsets(&self) -> [Vector3<f64>; 2] {
         self.offsets
     }
 }
@@ -97,13 +110,16 @@ mod tests {
         // 2000 N: still the speed bound.
         let mut targets = held_right_hand();
         press.apply(&mut targets, &wrench(2000.0), &config, dt);
-        assert!((press.offsets()[1] - 2.0 * 0.05 * dt).abs() < 1e-12);
+        assert!((press.offsets()[1].z - 2.0 * 0.05 * dt).abs() < 1e-12);
         // Nothing under the hand: it sinks, at most hand_press_depth_m.
         for _ in 0..10_000 {
             let mut targets = held_right_hand();
             press.apply(&mut targets, &wrench(0.0), &config, dt);
         }
-        assert_eq!(press.offsets(), [0.0, -config.hand_press_depth_m]);
+        assert_eq!(
+            press.offsets()[1],
+            Vector3::new(0.0, 0.0, -config.hand_press_depth_m)
+        );
     }
 
     #[test]
@@ -125,16 +141,42 @@ mod tests {
     }
 
     #[test]
+    fn a_hand_pushed_sideways_gives_way_as_far_as_the_slide_bound() {
+        // The rail pushes the palm 100 N towards +y while it presses with the force asked: the
+        // target moves +y at 5e-4 × 100 = 0.05 m/s, and no farther than hand_press_slide_m.
+        let (config, dt) = (ControllerConfig::default(), 0.002);
+        let mut press = HandPress::default();
+        let mut sideways = wrench(config.hand_force_n);
+        sideways[3][1] = 100.0;
+        let mut targets = held_right_hand();
+        press.apply(&mut targets, &sideways, &config, dt);
+        let offset = press.offsets()[1];
+        assert!(
+            (offset.y - 0.05 * dt).abs() < 1e-12 && offset.x == 0.0,
+            "{offset}"
+        );
+        assert!(
+            (targets.end_effectors[3].unwrap().pose.translation.y - (-0.45 + 0.05 * dt)).abs()
+                < 1e-12
+        );
+        for _ in 0..10_000 {
+            let mut targets = held_right_hand();
+            press.apply(&mut targets, &sideways, &config, dt);
+        }
+        assert!((press.offsets()[1].y - config.hand_press_slide_m).abs() < 1e-12);
+    }
+
+    #[test]
     fn a_hand_that_is_not_held_has_no_offset() {
         let config = ControllerConfig::default();
         let mut press = HandPress::default();
         let mut targets = held_right_hand();
         press.apply(&mut targets, &wrench(0.0), &config, 0.002);
-        assert!(press.offsets()[1] < 0.0);
+        assert!(press.offsets()[1].z < 0.0);
         targets.contacts[3] = false;
         let before = targets.end_effectors[3];
         press.apply(&mut targets, &wrench(0.0), &config, 0.002);
-        assert_eq!(press.offsets(), [0.0, 0.0]);
+        assert_eq!(press.offsets(), [Vector3::zeros(); 2]);
         assert_eq!(targets.end_effectors[3].unwrap().pose, before.unwrap().pose);
     }
 }

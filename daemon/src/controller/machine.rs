@@ -13,6 +13,7 @@ use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
 
 use super::config::ControllerConfig;
 use super::gait::{distribute, force_difference_velocities};
+use super::hand_support::{HandLoad, HandSupport};
 use super::plan::{Step, TransitionPlan};
 use super::sequence::PreparedSequence;
 use super::status::{FaultCode, Phase};
@@ -67,6 +68,12 @@ pub(crate) struct Targets {
     /// Replaces `posture_weight` on the torso joints (`[robot.joint_groups] torso`): the dynamic
     /// gait's `torso_posture_weight`; `None`: the configured posture weight.
     pub torso_posture_weight: Option<f64>,
+    /// The vertical force (N) asked of each held hand (left, right; `hand_support`), which its
+    /// admittance tracks; never less than the touch, `hand_force_n`.
+    pub hand_forces: [f64; 2],
+    /// The weight the held hands carry: `com` and the CoM's support polygon are the feet's
+    /// (their centre of pressure), which the QP maps into the CoM's by it.
+    pub hand_load: HandLoad,
 }
 
 impl Targets {
@@ -83,6 +90,8 @@ impl Targets {
             balance: Balance::SupportPolygon { height: None },
             contact_velocity: [[0.0; 6]; 2],
             torso_posture_weight: None,
+            hand_forces: [0.0; 2],
+            hand_load: HandLoad::NONE,
         }
     }
 
@@ -216,6 +225,10 @@ pub(crate) struct StateMachine {
     given_up: [bool; 4],
     /// Reaches given up since the sequence was loaded.
     reaches_given_up: u32,
+    /// The forces asked of the held hands.
+    hand_support: HandSupport,
+    /// The robot's weight (N).
+    weight_n: f64,
     targets: Targets,
 }
 
@@ -247,6 +260,8 @@ impl StateMachine {
             carried: [None; 4],
             given_up: [false; 4],
             reaches_given_up: 0,
+            hand_support: HandSupport::default(),
+            weight_n,
             targets: Targets::none(),
         }
     }
@@ -376,6 +391,16 @@ impl StateMachine {
     /// phase's completion and timeout (a reach that times out is given up, any other phase
     /// faults), advances, and refreshes the targets.
     pub fn update(&mut self, feedback: &Feedback, dt: f64) -> Progress {
+        // The machine moves the feet's centre of pressure: the CoM when no hand carries.
+        if feedback.measured {
+            self.hand_support.sense(&feedback.normal_forces, dt);
+        }
+        self.targets.hand_load = self.hand_support.load(&self.targets.anchors, self.weight_n);
+        let feet = self.targets.hand_load.feet_of(feedback.com.xy());
+        let feedback = &Feedback {
+            com: Vector3::new(feet.x, feet.y, feedback.com.z),
+            ..*feedback
+        };
         if !self.started {
             self.begin(feedback);
         } else {
@@ -394,14 +419,35 @@ impl StateMachine {
                 StepStatus::Complete => self.finish_step(feedback),
             }
             if !self.advance(feedback) {
-                self.refresh_targets(&feedback.pelvis);
+                self.refresh_targets(&feedback.pelvis, feedback.com.z);
+                self.support_hands(dt);
                 self.targets.contact_velocity = [[0.0; 6]; 2];
                 return Progress::Done;
             }
         }
-        self.refresh_targets(&feedback.pelvis);
+        self.refresh_targets(&feedback.pelvis, feedback.com.z);
+        self.support_hands(dt);
         self.comply(feedback);
         Progress::Running
+    }
+
+    /// Advances the forces asked of the held hands (`hand_support`): towards their share of the
+    /// weight, or back to the touch for the hand being unloaded.
+    fn support_hands(&mut self, dt: f64) {
+        let unloading = self
+            .started
+            .then(|| self.current_step())
+            .filter(|step| step.phase == Phase::Unload)
+            .and_then(|step| step.end_effector)
+            .filter(|e| !e.is_foot());
+        self.hand_support.update(
+            &self.targets.contacts,
+            unloading,
+            &self.config,
+            self.weight_n,
+            dt,
+        );
+        self.targets.hand_forces = self.hand_support.desired();
     }
 
     /// Force-difference control in double support: see [`double_support_compliance`]. Off
@@ -488,13 +534,6 @@ impl StateMachine {
             } else if self.given_up[h] {
                 next[h] = false;
             }
-            if !next[h] && self.targets.contacts[h] {
-                self.targets.contacts[h] = false;
-                if self.config.carry_released_hands {
-                    self.carried[h] =
-                        Some(heading_frame(&feedback.pelvis).inverse() * self.targets.anchors[h]);
-                }
-            }
         }
         self.plan = TransitionPlan::new(self.targets.contacts, next, is_last);
         self.step = 0;
@@ -543,6 +582,13 @@ impl StateMachine {
                     rise,
                 });
                 duration
+            }
+            (Phase::Unload, Some(hand)) if !hand.is_foot() => {
+                // Nothing moves: the force asked of the hand falls back to the touch, and the CoM
+                // with it to over the feet.
+                self.hand_support
+                    .unload_s(hand, &c, self.weight_n)
+                    .max(c.min_motion_s)
             }
             (Phase::Unload, Some(foot)) => {
                 // Straight up from where the foot is estimated to be (not its anchor): pulling it
@@ -717,8 +763,10 @@ impl StateMachine {
                         >= c.support_margin_m + c.com_tolerance_m;
                 self.com_time >= self.com_motion.duration() && (reached || stalled_inside)
             }
-            (Phase::Unload, Some(foot)) => {
-                self.debounced(feedback.normal_forces[foot as usize] < self.release_force)
+            (Phase::Unload, Some(e)) => {
+                let asked_no_more = e.is_foot() || self.hand_support.unloaded(e, &self.config);
+                let released = feedback.normal_forces[e as usize] < self.release_force;
+                asked_no_more && self.debounced(released)
             }
             (Phase::Lower, Some(foot)) => {
                 self.debounced(feedback.normal_forces[foot as usize] > self.touchdown_force)
@@ -792,32 +840,51 @@ impl StateMachine {
                 self.carried[i] = None;
                 self.targets.anchors[i] = *self.motion.goal();
             }
+            Phase::Unload if !e.is_foot() => {
+                // The hand carries no more than a touch: let it go.
+                self.targets.contacts[i] = false;
+                if self.config.carry_released_hands {
+                    self.carried[i] =
+                        Some(heading_frame(&feedback.pelvis).inverse() * self.targets.anchors[i]);
+                }
+            }
             Phase::Lift | Phase::Swing => self.free_targets[i] = Some(*self.motion.goal()),
             _ => {}
         }
     }
 
-    fn refresh_targets(&mut self, pelvis: &Isometry3<f64>) {
+    fn refresh_targets(&mut self, pelvis: &Isometry3<f64>, com_height: f64) {
         let (com, com_velocity) = self.com_motion.sample(self.com_time);
         self.targets.com = com;
         self.targets.com_velocity = com_velocity;
         let step = self.started.then(|| self.current_step());
         let shifting = step.is_some_and(|step| step.phase == Phase::ShiftCom);
+        // While a hand carries weight the CoM does not move up or down (outside a climb's
+        // shift): the palm is held on a rigid rail, and the stance knee straightening towards
+        // the legs' posture when JVRC-1 lifted its other foot raised the body 3 cm/s, pressed
+        // the palm into the rail with 1100 N and bounced it off.
+        let leaning = (self.targets.hand_load.share() > 0.0).then_some(ComHeight {
+            height: com_height,
+            velocity: 0.0,
+        });
         self.targets.balance = Balance::SupportPolygon {
             height: self
                 .com_climb
                 .filter(|_| shifting)
-                .map(|climb| climb.height(self.com_time, self.com_motion.duration())),
+                .map(|climb| climb.height(self.com_time, self.com_motion.duration()))
+                .or(leaning),
         };
+        // A hand being unloaded stays held where it is; a foot being unloaded rises.
+        let unloading_foot = step
+            .filter(|step| step.phase == Phase::Unload)
+            .and_then(|step| step.end_effector)
+            .filter(|e| e.is_foot());
         let moving = step.and_then(|step| match step.phase {
-            Phase::Unload | Phase::Lift | Phase::Swing | Phase::Lower | Phase::Reach => {
-                step.end_effector
-            }
+            Phase::Lift | Phase::Swing | Phase::Lower | Phase::Reach => step.end_effector,
             _ => None,
         });
-        self.targets.unloading = step
-            .filter(|step| step.phase == Phase::Unload)
-            .and_then(|step| step.end_effector);
+        let moving = moving.or(unloading_foot);
+        self.targets.unloading = unloading_foot;
         self.targets.reaching = EndEffector::ALL.map(|e| {
             step.is_some_and(|step| step.phase == Phase::Reach && step.end_effector == Some(e))
         });

@@ -42,6 +42,7 @@ mod estimator;
 mod gait;
 mod hand_clearance;
 mod hand_press;
+mod hand_support;
 mod machine;
 mod plan;
 mod sequence;

@@ -3,7 +3,8 @@
 //! Contacts are added before any is released, so support never shrinks before the new one is
 //! confirmed: for an added foot `Swing` (to just above the contact) then `Lower`; for an added
 //! hand `Reach`; for a released foot `ShiftCom` (over the remaining support), `Unload`, `Lift`,
-//! `Swing` (to the stance's swing pose). A transition with no foot released re-centres the CoM.
+//! `Swing` (to the stance's swing pose). A released hand is unloaded (`Unload`: its load handed
+//! back to the feet, `hand_support`) and let go before a foot is released. A transition with no foot released re-centres the CoM.
 //! The last transition ends with `Settle`.
 
 use kinematics::robot::EndEffector;
@@ -39,6 +40,11 @@ impl TransitionPlan {
                 plan.push(Phase::Lower, Some(e));
             } else if added(e) {
                 plan.push(Phase::Reach, Some(e));
+            }
+        }
+        for hand in EndEffector::HANDS {
+            if released(hand) {
+                plan.push(Phase::Unload, Some(hand));
             }
         }
         let mut foot_released = false;
@@ -121,6 +127,24 @@ mod tests {
                 .iter()
                 .all(|s| s.end_effector == Some(EndEffector::RightFoot))
         );
+    }
+
+    #[test]
+    fn a_released_hand_is_unloaded_before_a_foot_is_released() {
+        const BOTH_FEET_RIGHT_HAND: [bool; 4] = [true, true, false, true];
+        let (plan, phases) = plan(BOTH_FEET_RIGHT_HAND, LEFT_FOOT, false);
+        assert_eq!(
+            phases,
+            [
+                Phase::Unload,
+                Phase::ShiftCom,
+                Phase::Unload,
+                Phase::Lift,
+                Phase::Swing
+            ]
+        );
+        assert_eq!(plan.steps()[0].end_effector, Some(EndEffector::RightHand));
+        assert_eq!(plan.steps()[2].end_effector, Some(EndEffector::RightFoot));
     }
 
     #[test]

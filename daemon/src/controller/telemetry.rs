@@ -3,9 +3,9 @@
 
 use kinematics::ground::{SupportPolygon, sole_corners};
 use kinematics::robot::EndEffector;
-use nalgebra::Isometry3;
 use stance::Gait;
 
+use super::machine::Targets;
 use super::status::{ControllerState, ControllerStatus};
 use super::{Controller, pose_array};
 
@@ -25,9 +25,11 @@ pub struct ControllerTelemetry {
     /// Each end-effector's target: its anchor while in contact, else its pose task's set-point,
     /// `None` without either.
     pub targets: [Option<[f64; 7]>; 4],
-    /// The CoM x/y set-point while executing.
+    /// The CoM x/y set-point while executing (moved towards the held hands by the weight they
+    /// carry, `hand_support`).
     pub com_target: Option<[f64; 2]>,
-    /// Support polygon of the feet in contact (the polygon the CoM constraint uses).
+    /// Support polygon of the feet in contact, as the CoM constraint uses it: moved towards the
+    /// held hands by the weight they carry.
     pub support: SupportPolygon,
 }
 
@@ -55,25 +57,25 @@ impl Controller {
             base: pose_array(&self.configuration.base),
             end_effectors: self.poses.map(|pose| pose_array(&pose)),
             targets: target_poses,
-            com_target: executing.then(|| [targets.com.x, targets.com.y]),
-            support: self.support_polygon(&targets.contacts, &targets.anchors),
+            com_target: executing.then(|| {
+                let com = targets.hand_load.com_of(targets.com);
+                [com.x, com.y]
+            }),
+            support: self.support_polygon(targets),
         }
     }
 
     /// The convex hull of the sole corners of the feet in contact at their anchors, as the QP's
-    /// CoM constraint builds it.
-    fn support_polygon(
-        &self,
-        contacts: &[bool; 4],
-        anchors: &[Isometry3<f64>; 4],
-    ) -> SupportPolygon {
+    /// CoM constraint builds it (moved towards the held hands).
+    fn support_polygon(&self, targets: &Targets) -> SupportPolygon {
         let mut corners = [[0.0; 2]; 8];
         let mut count = 0;
         for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
-            if !contacts[foot as usize] {
+            if !targets.contacts[foot as usize] {
                 continue;
             }
-            for corner in sole_corners(&anchors[foot as usize], &self.robot.sole) {
+            for corner in sole_corners(&targets.anchors[foot as usize], &self.robot.sole) {
+                let corner = targets.hand_load.com_of(corner.xy());
                 corners[count] = [corner.x, corner.y];
                 count += 1;
             }
