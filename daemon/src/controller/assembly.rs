@@ -419,23 +419,17 @@ mod tests {
     use crate::controller::machine::StateMachine;
     use kinematics::robot::SoleRectangle;
 
-    /// The linear term of the QP at the standing posture, with `posture` as the stance's `q_S`,
-    /// before a walk (no contact, no task).
-    fn linear_term(
-        robot: &Robot,
-        config: &ControllerConfig,
-        posture: &DVector<f64>,
-    ) -> DVector<f64> {
-        let sole = SoleRectangle {
-            length: 0.2,
-            width: 0.08,
-        };
-        let machine = StateMachine::new(config, sole, 600.0);
-        linear_term_with(robot, config, posture, machine.targets())
+    /// JVRC-1's robot and `[controller]`.
+    fn jvrc1() -> (Robot, ControllerConfig) {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/jvrc1.toml");
+        let robot = Robot::load(&path, None).expect("the JVRC-1 config loads");
+        let config = ControllerConfig::from_config_file(&path).expect("its [controller] loads");
+        (robot, config)
     }
 
-    /// [`linear_term`] with `targets`.
-    fn linear_term_with(
+    /// The linear term of the QP at the standing posture with `targets`, `posture` as the
+    /// stance's `q_S`.
+    fn linear_term(
         robot: &Robot,
         config: &ControllerConfig,
         posture: &DVector<f64>,
@@ -457,49 +451,48 @@ mod tests {
         assembler.problem().q().into_owned()
     }
 
+    /// Which of `joints` the stance's posture pulls with `targets`: the QP's linear term at the
+    /// joint changes when the stance's angle of every one of them does (by 0.5 rad).
+    fn pulled<const N: usize>(
+        robot: &Robot,
+        config: &ControllerConfig,
+        targets: &Targets,
+        joints: [usize; N],
+    ) -> [bool; N] {
+        let standing = robot.standing.joints.clone();
+        let mut moved = standing.clone();
+        for joint in joints {
+            moved[joint] -= 0.5;
+        }
+        let a = linear_term(robot, config, &standing, targets);
+        let b = linear_term(robot, config, &moved, targets);
+        joints.map(|joint| (a[6 + joint] - b[6 + joint]).abs() > 1e-4)
+    }
+
     #[test]
     fn the_legs_posture_is_the_standing_one_and_the_arms_follow_the_stance() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/jvrc1.toml");
-        let robot = Robot::load(&path, None).expect("the JVRC-1 config loads");
-        let config = ControllerConfig::from_config_file(&path).expect("its [controller] loads");
-        let knee = robot
-            .model
-            .joint_index("R_KNEE")
-            .expect("JVRC-1 has R_KNEE");
-        let elbow = robot
-            .model
-            .joint_index("R_ELBOW_P")
-            .expect("JVRC-1 has R_ELBOW_P");
-        let standing = robot.standing.joints.clone();
-        let mut crouched = standing.clone();
-        crouched[knee] += 0.5;
-        crouched[elbow] -= 0.5;
-        let (a, b) = (
-            linear_term(&robot, &config, &standing),
-            linear_term(&robot, &config, &crouched),
+        let (robot, config) = jvrc1();
+        let joint = |name| robot.model.joint_index(name).expect("a JVRC-1 joint");
+        let sole = SoleRectangle {
+            length: 0.2,
+            width: 0.08,
+        };
+        // Before a walk: no contact, no task.
+        let machine = StateMachine::new(&config, sole, 600.0);
+        let [knee, elbow] = pulled(
+            &robot,
+            &config,
+            machine.targets(),
+            [joint("R_KNEE"), joint("R_ELBOW_P")],
         );
-        assert_eq!(
-            a[6 + knee],
-            b[6 + knee],
-            "a stance's knee angle pulls the knee"
-        );
-        assert!(
-            (a[6 + elbow] - b[6 + elbow]).abs() > 1e-4,
-            "the stance's elbow angle does not pull the elbow"
-        );
+        assert!(!knee, "a stance's knee angle pulls the knee");
+        assert!(elbow, "the stance's elbow angle does not pull the elbow");
     }
 
     #[test]
     fn the_arm_of_a_hand_that_carries_weight_keeps_where_it_is() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/jvrc1.toml");
-        let robot = Robot::load(&path, None).expect("the JVRC-1 config loads");
-        let config = ControllerConfig::from_config_file(&path).expect("its [controller] loads");
+        let (robot, config) = jvrc1();
         let joint = |name| robot.model.joint_index(name).expect("a JVRC-1 joint");
-        let (right_elbow, left_elbow) = (joint("R_ELBOW_P"), joint("L_ELBOW_P"));
-        let standing = robot.standing.joints.clone();
-        let mut bent = standing.clone();
-        bent[right_elbow] -= 0.5;
-        bent[left_elbow] -= 0.5;
         // The right hand held and measured carrying 100 N.
         let mut targets = Targets::none();
         targets.contacts = [true, true, false, true];
@@ -510,18 +503,16 @@ mod tests {
         }
         targets.hand_load = support.load(&targets.anchors, 600.0);
         assert!(targets.hand_load.carries(EndEffector::RightHand));
-        let (a, b) = (
-            linear_term_with(&robot, &config, &standing, &targets),
-            linear_term_with(&robot, &config, &bent, &targets),
-        );
-        assert_eq!(
-            a[6 + right_elbow],
-            b[6 + right_elbow],
-            "the stance's elbow angle pulls the carrying arm"
+        let [right_elbow, left_elbow] = pulled(
+            &robot,
+            &config,
+            &targets,
+            [joint("R_ELBOW_P"), joint("L_ELBOW_P")],
         );
         assert!(
-            (a[6 + left_elbow] - b[6 + left_elbow]).abs() > 1e-4,
-            "the free arm no longer follows the stance"
+            !right_elbow,
+            "the stance's elbow angle pulls the carrying arm"
         );
+        assert!(left_elbow, "the free arm no longer follows the stance");
     }
 }
