@@ -28,7 +28,7 @@ use daemon::controller::{
     DynamicGaitConfig, FaultCode, Gait, GaitConfig, Phase, SolverKind,
 };
 use kinematics::ConfigFile;
-use kinematics::ground::{GRAVITY, SupportPolygon, sole_corners};
+use kinematics::ground::{GRAVITY, SupportPolygon};
 use kinematics::robot::{EndEffector, Robot, SoleRectangle};
 use nalgebra::{Isometry3, Vector2, Vector3};
 use sim_adapter::MotorLoad;
@@ -729,19 +729,14 @@ impl LoopState {
 
     /// Drift and fall indicators of the state after a tick.
     fn observe(&mut self, sim: &MujocoSim, status: &ControllerStatus) {
-        let mut corners = [[0.0; 2]; 8];
-        let mut count = 0;
-        for foot in FEET.into_iter().filter(|f| status.contacts[*f as usize]) {
-            for corner in sole_corners(&sim.end_effector_pose(foot), &self.sole) {
-                corners[count] = [corner.x, corner.y];
-                count += 1;
-            }
-        }
+        let soles =
+            FEET.map(|foot| status.contacts[foot as usize].then(|| sim.end_effector_pose(foot)));
+        let mut feet = SupportPolygon::empty();
+        feet.set_soles(soles.iter().flatten(), &self.sole, |p| p);
         let com = sim.measurement().com;
-        let feet = SupportPolygon::from_points(&corners[..count]);
         // No sole in contact counts as inside: there is no polygon to be outside of.
         let outside = -feet.signed_distance([com.x, com.y]);
-        self.com_outside.push(if count == 0 {
+        self.com_outside.push(if soles.iter().all(Option::is_none) {
             f64::NEG_INFINITY
         } else {
             outside

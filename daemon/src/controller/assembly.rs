@@ -30,7 +30,7 @@ use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{DMatrix, DVector, Isometry3, UnitQuaternion, Vector3};
 
-use kinematics::ground::{MAX_SUPPORT_POINTS, SupportPolygon, sole_corners};
+use kinematics::ground::{MAX_SUPPORT_POINTS, SupportPolygon};
 
 use super::config::ControllerConfig;
 use super::machine::{Balance, PoseTarget, Targets};
@@ -52,7 +52,6 @@ pub(crate) struct QpAssembler {
     /// Base orientation of the standing posture: "upright" means no roll/pitch relative to it.
     upright_reference: UnitQuaternion<f64>,
     polygon: SupportPolygon,
-    corners: [[f64; 2]; MAX_SUPPORT_POINTS],
     /// Whether each joint belongs to `[robot.joint_groups] torso`.
     torso_joints: Vec<bool>,
     /// Whether each joint belongs to `[robot.joint_groups] legs`.
@@ -116,7 +115,6 @@ impl QpAssembler {
             all_columns: (0..nv).collect(),
             upright_reference: robot.standing.base.rotation,
             polygon: SupportPolygon::empty(),
-            corners: [[0.0; 2]; MAX_SUPPORT_POINTS],
             torso_joints,
             leg_joints: (0..model.dof())
                 .map(|j| robot.joint_groups.legs.contains(&j))
@@ -153,7 +151,7 @@ impl QpAssembler {
             .count();
         let m_ineq = match targets.balance {
             Balance::SupportPolygon { .. } => {
-                self.polygon_from_contacts(robot, targets);
+                targets.com_support(&robot.sole, &mut self.polygon);
                 self.polygon.edge_count()
             }
             Balance::Pendulum(_) => 0,
@@ -231,9 +229,7 @@ impl QpAssembler {
         // The base Jacobian's angular rows are the identity on ω.
         let relative = configuration.base.rotation * self.upright_reference.inverse();
         let (_, _, yaw) = relative.euler_angles();
-        let leaning = EndEffector::HANDS
-            .iter()
-            .any(|hand| targets.hand_load.carries(*hand));
+        let leaning = targets.hand_load.share() > 0.0;
         self.held_yaw = leaning.then(|| self.held_yaw.unwrap_or(yaw));
         let upright = UnitQuaternion::from_euler_angles(0.0, 0.0, self.held_yaw.unwrap_or(yaw));
         let tilt = (upright * relative.inverse()).scaled_axis();
@@ -247,16 +243,16 @@ impl QpAssembler {
         // through the pose task's null space (its reference is where it is): the next stance's
         // arm posture swung JVRC-1's wrist at 0.4 rad/s while its palm leant on a rail with 130 N,
         // and the palm came off it.
-        let held = EndEffector::HANDS.map(|hand| targets.hand_load.carries(hand));
+        let carrying = EndEffector::HANDS.map(|hand| targets.hand_load.carries(hand));
         for j in 0..model.dof() {
             let weight = match targets.torso_posture_weight {
                 Some(weight) if self.torso_joints[j] => weight,
                 _ => config.posture_weight,
             };
-            let holding = (0..2).any(|h| held[h] && self.arm_joints[h][j]);
+            let carrying_arm = (0..2).any(|h| carrying[h] && self.arm_joints[h][j]);
             let reference = if self.leg_joints[j] {
                 robot.standing.joints[j]
-            } else if holding {
+            } else if carrying_arm {
                 configuration.joints[j]
             } else {
                 posture[j]
@@ -339,23 +335,6 @@ impl QpAssembler {
             x_min[6 + j] = lower.min(upper);
             x_max[6 + j] = upper.max(lower);
         }
-    }
-
-    /// Hull of the sole corners of the feet in contact (at their anchors), as the CoM's: moved
-    /// towards the held hands by the share of the weight they carry (`hand_support`).
-    fn polygon_from_contacts(&mut self, robot: &Robot, targets: &Targets) {
-        let mut count = 0;
-        for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
-            if !targets.contacts[foot as usize] {
-                continue;
-            }
-            for corner in sole_corners(&targets.anchors[foot as usize], &robot.sole) {
-                let corner = targets.hand_load.com_of(corner.xy());
-                self.corners[count] = [corner.x, corner.y];
-                count += 1;
-            }
-        }
-        self.polygon.set_hull(&self.corners[..count]);
     }
 }
 

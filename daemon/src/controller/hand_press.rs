@@ -23,6 +23,7 @@ use kinematics::robot::EndEffector;
 use nalgebra::Vector3;
 
 use super::config::ControllerConfig;
+use super::hand_support::hand_slot;
 use super::machine::Targets;
 
 /// The held hands' target offsets (m, world; see the module docs).
@@ -49,7 +50,7 @@ impl HandPress {
                 *offset = Vector3::zeros();
                 continue;
             };
-            let asked = targets.hand_forces[h - EndEffector::LeftHand as usize];
+            let asked = targets.hand_forces[hand_slot(hand)];
             let wanted = Vector3::new(0.0, 0.0, asked.max(config.hand_force_n));
             let force = Vector3::new(wrenches[h][0], wrenches[h][1], wrenches[h][2]);
             let speed = config.hand_press_speed;

@@ -175,7 +175,7 @@ impl HandSupport {
 }
 
 /// Index of `hand` in a per-hand array (left, right).
-fn hand_slot(hand: EndEffector) -> usize {
+pub(crate) fn hand_slot(hand: EndEffector) -> usize {
     hand as usize - EndEffector::LeftHand as usize
 }
 

@@ -6,7 +6,7 @@
 //! agree with the state machine. Every phase has a planned duration; exceeding it by the
 //! configured timeout is a fault.
 
-use kinematics::ground::{SupportPolygon, sole_corners};
+use kinematics::ground::SupportPolygon;
 use kinematics::ground::{planar_frame, sequence_alignment};
 use kinematics::robot::{EndEffector, SoleRectangle};
 use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
@@ -101,6 +101,20 @@ impl Targets {
         for anchor in &mut self.anchors {
             *anchor = motion * *anchor;
         }
+    }
+
+    /// The support polygon the CoM stays over (the static gait's constraint): the hull of the
+    /// soles in contact at their anchors, moved towards the held hands by the weight they carry
+    /// (`hand_support`), into `polygon`.
+    pub fn com_support(&self, sole: &SoleRectangle, polygon: &mut SupportPolygon) {
+        let feet = FEET
+            .iter()
+            .filter(|&&foot| self.contacts[foot as usize])
+            .map(|&foot| &self.anchors[foot as usize]);
+        polygon.set_soles(feet, sole, |[x, y]| {
+            let com = self.hand_load.com_of(Vector2::new(x, y));
+            [com.x, com.y]
+        });
     }
 
     /// World anchors of the feet in contact, for the estimator.
@@ -731,18 +745,11 @@ impl StateMachine {
 
     /// The polygon of the feet in contact except `excluded`.
     fn set_com_support(&mut self, excluded: Option<EndEffector>) {
-        let mut corners = [[0.0; 2]; 8];
-        let mut count = 0;
-        for foot in FEET {
-            if Some(foot) == excluded || !self.targets.contacts[foot as usize] {
-                continue;
-            }
-            for corner in sole_corners(&self.targets.anchors[foot as usize], &self.sole) {
-                corners[count] = [corner.x, corner.y];
-                count += 1;
-            }
-        }
-        self.com_support.set_hull(&corners[..count]);
+        let staying = FEET
+            .iter()
+            .filter(|&&foot| Some(foot) != excluded && self.targets.contacts[foot as usize])
+            .map(|&foot| &self.targets.anchors[foot as usize]);
+        self.com_support.set_soles(staying, &self.sole, |p| p);
     }
 
     fn check_step(&mut self, feedback: &Feedback) -> StepStatus {

@@ -1,7 +1,7 @@
 //! [`Controller::telemetry`]: the estimate and set-points of the last tick as plain `Copy` data,
 //! for observers (the runtime publishes it on `telemetry` after each tick's command).
 
-use kinematics::ground::{SupportPolygon, sole_corners};
+use kinematics::ground::SupportPolygon;
 use kinematics::robot::EndEffector;
 use stance::Gait;
 
@@ -65,21 +65,10 @@ impl Controller {
         }
     }
 
-    /// The convex hull of the sole corners of the feet in contact at their anchors, as the QP's
-    /// CoM constraint builds it (moved towards the held hands).
+    /// The support polygon the QP's CoM constraint uses ([`Targets::com_support`]).
     fn support_polygon(&self, targets: &Targets) -> SupportPolygon {
-        let mut corners = [[0.0; 2]; 8];
-        let mut count = 0;
-        for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
-            if !targets.contacts[foot as usize] {
-                continue;
-            }
-            for corner in sole_corners(&targets.anchors[foot as usize], &self.robot.sole) {
-                let corner = targets.hand_load.com_of(corner.xy());
-                corners[count] = [corner.x, corner.y];
-                count += 1;
-            }
-        }
-        SupportPolygon::from_points(&corners[..count])
+        let mut support = SupportPolygon::empty();
+        targets.com_support(&self.robot.sole, &mut support);
+        support
     }
 }

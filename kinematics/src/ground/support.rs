@@ -47,6 +47,26 @@ impl SupportPolygon {
         self.len = 0;
     }
 
+    /// Replaces the polygon by the convex hull of the corners of soles `sole` at `poses` (the
+    /// feet in contact), each corner's ground point passed through `map` first (`|p| p` for the
+    /// soles' own polygon). At most [`MAX_SUPPORT_POINTS`] / 4 soles; allocation-free.
+    pub fn set_soles<'a>(
+        &mut self,
+        poses: impl IntoIterator<Item = &'a Isometry3<f64>>,
+        sole: &SoleRectangle,
+        map: impl Fn([f64; 2]) -> [f64; 2],
+    ) {
+        let mut corners = [[0.0; 2]; MAX_SUPPORT_POINTS];
+        let mut count = 0;
+        for pose in poses {
+            for corner in sole_corners(pose, sole) {
+                corners[count] = map([corner.x, corner.y]);
+                count += 1;
+            }
+        }
+        self.set_hull(&corners[..count]);
+    }
+
     /// Replaces the polygon by the convex hull of `points` (Andrew's monotone chain).
     ///
     /// # Panics
@@ -279,6 +299,29 @@ fn segment_nearest(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_soles_polygon_is_the_hull_of_their_corners_mapped() {
+        let sole = SoleRectangle {
+            length: 0.2,
+            width: 0.1,
+        };
+        let feet = [
+            Isometry3::translation(0.0, 0.1, 0.0),
+            Isometry3::translation(0.0, -0.1, 0.0),
+        ];
+        let mut polygon = SupportPolygon::empty();
+        polygon.set_soles(&feet, &sole, |p| p);
+        // The rectangle spanning both soles: x in ±0.1, y in ±0.15.
+        assert_eq!(polygon.vertices().len(), 4);
+        assert!((polygon.signed_distance([0.0, 0.0]) - 0.1).abs() < 1e-12);
+        // Each corner halved towards the origin: half the margin.
+        polygon.set_soles(&feet, &sole, |[x, y]| [x / 2.0, y / 2.0]);
+        assert!((polygon.signed_distance([0.0, 0.0]) - 0.05).abs() < 1e-12);
+        // No sole: empty.
+        polygon.set_soles(&[], &sole, |p| p);
+        assert!(polygon.vertices().is_empty());
+    }
 
     fn square() -> SupportPolygon {
         SupportPolygon::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.5, 0.5], [1.0, 1.0], [0.0, 1.0]])

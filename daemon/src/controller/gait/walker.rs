@@ -33,8 +33,8 @@
 //! `late_touchdown_max_s` of the planned touchdown ends the stop with
 //! [`FaultCode::StopCouldNotLand`].
 
+use kinematics::ground::SupportPolygon;
 use kinematics::ground::sequence_alignment;
-use kinematics::ground::{SupportPolygon, sole_corners};
 use kinematics::robot::{EndEffector, SoleRectangle};
 use nalgebra::{DVector, Isometry3, UnitQuaternion, Vector2, Vector3};
 
@@ -736,18 +736,11 @@ impl DynamicWalker {
 
     /// The polygon of the feet in contact.
     fn set_support(&mut self) {
-        let mut corners = [[0.0; 2]; 8];
-        let mut count = 0;
-        for foot in FEET {
-            if !self.targets.contacts[foot as usize] {
-                continue;
-            }
-            for corner in sole_corners(&self.targets.anchors[foot as usize], &self.sole) {
-                corners[count] = [corner.x, corner.y];
-                count += 1;
-            }
-        }
-        self.support.set_hull(&corners[..count]);
+        let standing = FEET
+            .iter()
+            .filter(|&&foot| self.targets.contacts[foot as usize])
+            .map(|&foot| &self.targets.anchors[foot as usize]);
+        self.support.set_soles(standing, &self.sole, |p| p);
     }
 
     fn refresh_targets(&mut self, pelvis: &Isometry3<f64>) {
