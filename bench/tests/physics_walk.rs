@@ -214,6 +214,49 @@ mod walks {
         );
     }
 
+    /// JVRC-1 walking statically down `stairs-down-10cm.toml` (seed 0) cannot reach the first
+    /// stair's tread, 0.29 m ahead and 0.10 m down, with its CoM over the standing foot: the QP
+    /// lowered the body on the standing knee to bring the foot down, the knee gave way 8 cm
+    /// down, and the robot fell backwards with the foot 4 cm above the tread, with no fault.
+    /// Now the step is taken back once the crouch it needs passes `standing_crouch_max_m`: the
+    /// foot returns to the landing it lifted off, and the robot stands in the
+    /// `step_out_of_reach` fault (3 s after it). Whether a later change lets it descend or not,
+    /// it must not fall.
+    #[test]
+    fn jvrc1_takes_back_a_static_step_down_beyond_its_reach() {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../configs/scenes/stairs-down-10cm.toml");
+        let scene = std::sync::Arc::new(stance::Scene::from_path(&file).expect("scene loads"));
+        let options = PhysicsWalkOptions {
+            gait: stance::Gait::Static,
+            scene: Some(scene.clone()),
+            settle_s: 3.0,
+            ..PhysicsWalkOptions::default()
+        };
+        let request = WalkRequest {
+            distance: scene.path_length(),
+            affordances: AffordanceSet::Feet,
+            seed: 0,
+            speed: None,
+        };
+        let report = walk_distance(&config("jvrc1"), None, &request, &options).expect("walks");
+        print_report(
+            "jvrc1 static stairs-down-10cm seed 0",
+            request.distance,
+            &report,
+        );
+        assert!(
+            matches!(
+                report.outcome,
+                PhysicsOutcome::Done | PhysicsOutcome::Fault(FaultCode::StepOutOfReach)
+            ),
+            "ended `{}` at {:.2} s simulated, {:.2} m along",
+            report.outcome.label(),
+            report.sim_s,
+            report.distance_m
+        );
+    }
+
     /// JVRC-1 walks the 5 m of `railing.toml`, the rail 0.45 m to its right at 0.8 m: with its
     /// feet alone in the dynamic gait, and holding the rail with its right hand in the static
     /// gait (seed 1, whose hand lets go on the rail whenever the right foot steps). Before free

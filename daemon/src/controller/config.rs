@@ -125,6 +125,13 @@ pub struct ControllerConfig {
     /// fault: a robot tipping over its stance foot's edge mid-swing falls before the feet roll
     /// by `tipping_detection_rad`. Must stay above the stance sole's ordinary roll.
     pub catch_tilt_rad: f64,
+    /// How deep (m) the standing leg may lower the body under the whole weight while a foot is
+    /// in the air (the static gait): a landing that needs more (the CoM's sink below its height
+    /// at the release plus what the foot still has to descend, once the sink passes half of
+    /// this) is beyond reach, and the step is taken back: the foot returns to where it lifted
+    /// off and the walk ends in the `step_out_of_reach` fault. A robot's knees set it (JVRC-1's
+    /// gave way 8 cm down; ARMAR-4 lands steps 11 cm down).
+    pub standing_crouch_max_m: f64,
     /// How fast leg odometry's heading is turned onto the IMU's (rad/s; 0: leg odometry alone).
     /// Odometry cannot see the feet turning together on the ground (down a stair, a touchdown
     /// turns both by up to 0.01 rad, always the same way when the same foot leads), and the walk
@@ -243,6 +250,7 @@ impl Default for ControllerConfig {
             unload_foot_weight: 100.0,
             tipping_detection_rad: 0.25,
             catch_tilt_rad: 0.1,
+            standing_crouch_max_m: 0.09,
             heading_correction_speed: 0.05,
             carry_released_hands: false,
             hand_approach_height_m: 0.08,
@@ -441,6 +449,12 @@ impl ControllerConfig {
                 1.5,
             ),
             Bound::new("catch_tilt_rad", self.catch_tilt_rad, 0.01, 1.5),
+            Bound::new(
+                "standing_crouch_max_m",
+                self.standing_crouch_max_m,
+                0.005,
+                1.0,
+            ),
             Bound::new(
                 "heading_correction_speed",
                 self.heading_correction_speed,

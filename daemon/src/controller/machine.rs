@@ -227,9 +227,12 @@ pub(crate) struct StateMachine {
     /// elevation; outside a shift, and with `None`, the height is free (the posture's).
     com_climb: Option<ComClimb>,
     free_targets: [Option<Isometry3<f64>>; 4],
-    /// The foot being put down to end the walk and the pose on the ground below it that
-    /// replaces its stance target (`catch_swing_foot`).
-    catch: Option<(EndEffector, Isometry3<f64>)>,
+    /// The foot being put down to end the walk and the pose that replaces its stance target: on
+    /// the ground below it (`catch_swing_foot`) or where it lifted off (`take_step_back`).
+    put_down: Option<(EndEffector, Isometry3<f64>)>,
+    /// Estimated CoM height when the foot in the air was released (m): the standing leg must
+    /// hold the body up until that foot lands (`standing_crouch_max_m`).
+    release_com_height: f64,
     /// Released hands, carried along with the pelvis: their pose relative to its planar frame
     /// (x, y, yaw) at release. Planar, so the pelvis roll of ARMAR-4's hip strategy does not
     /// swing them sideways.
@@ -270,7 +273,8 @@ impl StateMachine {
             com_time: 0.0,
             com_climb: None,
             free_targets: [None; 4],
-            catch: None,
+            put_down: None,
+            release_com_height: f64::NAN,
             carried: [None; 4],
             given_up: [false; 4],
             reaches_given_up: 0,
@@ -350,7 +354,7 @@ impl StateMachine {
     /// Installs a sequence to execute from the next update; returns the previous one.
     pub fn load(&mut self, sequence: Box<PreparedSequence>) -> Option<Box<PreparedSequence>> {
         self.started = false;
-        self.catch = None;
+        self.put_down = None;
         self.stance = 0;
         self.given_up = [false; 4];
         self.reaches_given_up = 0;
@@ -360,7 +364,7 @@ impl StateMachine {
     /// Stops executing (the contact set and anchors stay as they are).
     pub fn stop(&mut self) {
         self.started = false;
-        self.catch = None;
+        self.put_down = None;
         self.deadline = f64::INFINITY;
     }
 
@@ -397,8 +401,57 @@ impl StateMachine {
         self.phase_time = 0.0;
         self.debounce = 0;
         self.deadline = CATCH_S + self.config.phase_timeout_s;
-        self.catch = Some((foot, below));
+        self.put_down = Some((foot, below));
         true
+    }
+
+    /// Whether a foot is being put down to end the walk (a catch, a step taken back).
+    pub fn putting_foot_down(&self) -> bool {
+        self.put_down.is_some()
+    }
+
+    /// The standing leg would have to crouch deeper than `standing_crouch_max_m` to land the foot
+    /// in the air: the CoM sank more than half that below its height at the release, and that
+    /// sink plus what the foot still has to descend to its foothold (a foot at full reach comes
+    /// down only as far as the body does) exceeds it. A landing beyond the swing leg's reach
+    /// makes the QP lower the body on the standing knee to bring the foot down: JVRC-1 down a
+    /// 10 cm stair, 0.29 m ahead, sank with the foot until its knee gave way 8 cm down and it
+    /// fell (MuJoCo), where ARMAR-4 lands the same step 11 cm down.
+    fn standing_leg_gives_way(&self, feedback: &Feedback) -> bool {
+        let step = self.current_step();
+        let Some(foot) = step.end_effector.filter(|e| e.is_foot()) else {
+            return false;
+        };
+        if self.put_down.is_some()
+            || !matches!(step.phase, Phase::Lift | Phase::Swing | Phase::Lower)
+        {
+            return false;
+        }
+        let budget = self.config.standing_crouch_max_m;
+        let sink = self.release_com_height - feedback.com.z;
+        let to_descend =
+            (feedback.poses[foot as usize].translation.z - self.landing_height(foot)).max(0.0);
+        sink > budget / 2.0 && sink + to_descend > budget
+    }
+
+    /// Takes the step back (`standing_leg_gives_way`): the foot rises straight up above both the
+    /// surface it left and where it is, moves back over where it lifted off, and is lowered there
+    /// until its touchdown is confirmed; then the walk ends. The rest of the sequence is dropped.
+    fn take_step_back(&mut self, feedback: &Feedback) {
+        let Some(foot) = self.current_step().end_effector else {
+            return;
+        };
+        let back = self.targets.anchors[foot as usize];
+        let start = feedback.poses[foot as usize];
+        let above = (back.translation.z - start.translation.z).max(0.0) + self.config.lift_height_m;
+        self.timed_motion(start, raised(&start, above), Profile::MinimumJerk);
+        self.motion_is_via = true;
+        self.plan = TransitionPlan::step_back(foot);
+        self.step = 0;
+        self.phase_time = 0.0;
+        self.debounce = 0;
+        self.deadline = self.motion.duration() + self.config.phase_timeout_s;
+        self.put_down = Some((foot, back));
     }
 
     /// One tick of the sequence: starts it on the first call after `load`, checks the current
@@ -421,6 +474,11 @@ impl StateMachine {
             self.phase_time += dt;
             self.com_time += dt;
         }
+        let mut progress = Progress::Running;
+        if self.standing_leg_gives_way(feedback) {
+            self.take_step_back(feedback);
+            progress = Progress::Stopping(FaultCode::StepOutOfReach);
+        }
         loop {
             match self.check_step(feedback) {
                 StepStatus::Running => break,
@@ -442,7 +500,7 @@ impl StateMachine {
         self.refresh_targets(&feedback.pelvis, feedback.com.z);
         self.support_hands(dt);
         self.comply(feedback);
-        Progress::Running
+        progress
     }
 
     /// Advances the forces asked of the held hands (`hand_support`): towards their share of the
@@ -520,7 +578,7 @@ impl StateMachine {
     }
 
     fn world_target(&self, e: EndEffector) -> Isometry3<f64> {
-        match self.catch {
+        match self.put_down {
             Some((foot, below)) if foot == e => below,
             _ => self.to_world * self.sequence().stances[self.stance].targets[e as usize],
         }
@@ -558,7 +616,7 @@ impl StateMachine {
     /// foot touched down).
     fn advance(&mut self, feedback: &Feedback) -> bool {
         self.step += 1;
-        if self.catch.is_some() && self.step == self.plan.steps().len() {
+        if self.put_down.is_some() && self.step == self.plan.steps().len() {
             self.stop();
             return false;
         }
@@ -609,6 +667,7 @@ impl StateMachine {
                 // back to the anchor would drag it along the ground while it still touches.
                 let start = feedback.poses[foot as usize];
                 self.targets.contacts[foot as usize] = false;
+                self.release_com_height = feedback.com.z;
                 let goal = raised(&start, c.unload_lift_m);
                 self.motion =
                     PoseTrajectory::new(start, goal, c.min_motion_s, Profile::MinimumJerk);
@@ -628,7 +687,10 @@ impl StateMachine {
                 let start =
                     self.free_targets[foot as usize].unwrap_or(feedback.poses[foot as usize]);
                 let target = self.world_target(foot);
-                self.motion_is_via = !self.sequence().stances[self.stance].contacts[foot as usize];
+                // A foot swung to the stance it is in the air in swings to its via pose; one
+                // that lands (or is put down) ends its swing above its foothold.
+                self.motion_is_via = self.put_down.is_none()
+                    && !self.sequence().stances[self.stance].contacts[foot as usize];
                 let goal = if self.motion_is_via {
                     target
                 } else {
@@ -754,7 +816,7 @@ impl StateMachine {
 
     fn check_step(&mut self, feedback: &Feedback) -> StepStatus {
         let step = self.current_step();
-        let caught_on_ground = match (self.catch, step.phase) {
+        let caught_on_ground = match (self.put_down, step.phase) {
             (Some((foot, _)), Phase::Swing) => {
                 self.debounced(feedback.normal_forces[foot as usize] > self.touchdown_force)
             }
@@ -835,7 +897,7 @@ impl StateMachine {
                 // would let the height estimate sink a little with every step.
                 // A caught foot meets the ground wherever it is (it is anchored as estimated).
                 let mut anchor = feedback.poses[i];
-                if self.catch.is_none() {
+                if self.put_down.is_none() {
                     anchor.translation.z = self.world_target(e).translation.z;
                 }
                 self.targets.contacts[i] = true;

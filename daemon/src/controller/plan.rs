@@ -75,6 +75,16 @@ impl TransitionPlan {
         plan
     }
 
+    /// A step taken back (`StateMachine::take_step_back`): `foot` lifted clear, swung back over
+    /// where it lifted off, then lowered until it touches down.
+    pub fn step_back(foot: EndEffector) -> Self {
+        let mut plan = Self::empty();
+        plan.push(Phase::Lift, Some(foot));
+        plan.push(Phase::Swing, Some(foot));
+        plan.push(Phase::Lower, Some(foot));
+        plan
+    }
+
     fn empty() -> Self {
         Self {
             steps: [Step {
@@ -147,16 +157,34 @@ mod tests {
         assert_eq!(plan.steps()[2].end_effector, Some(EndEffector::RightFoot));
     }
 
-    #[test]
-    fn a_catch_brings_the_foot_over_the_ground_then_lowers_it() {
-        let plan = TransitionPlan::catch(EndEffector::RightFoot);
-        let steps: Vec<_> = plan
-            .steps()
+    /// A put-down plan's (phase, end-effector) pairs in order.
+    fn moves(plan: &TransitionPlan) -> Vec<(Phase, Option<EndEffector>)> {
+        plan.steps()
             .iter()
             .map(|s| (s.phase, s.end_effector))
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn a_catch_brings_the_foot_over_the_ground_then_lowers_it() {
         let foot = Some(EndEffector::RightFoot);
-        assert_eq!(steps, [(Phase::Swing, foot), (Phase::Lower, foot)]);
+        assert_eq!(
+            moves(&TransitionPlan::catch(EndEffector::RightFoot)),
+            [(Phase::Swing, foot), (Phase::Lower, foot)]
+        );
+    }
+
+    #[test]
+    fn a_step_taken_back_lifts_swings_and_lowers_the_foot() {
+        let foot = Some(EndEffector::LeftFoot);
+        assert_eq!(
+            moves(&TransitionPlan::step_back(EndEffector::LeftFoot)),
+            [
+                (Phase::Lift, foot),
+                (Phase::Swing, foot),
+                (Phase::Lower, foot)
+            ]
+        );
     }
 
     #[test]

@@ -63,10 +63,15 @@ impl Sequencer {
         self.fallback.stop();
     }
 
-    /// Ends a dynamic walk under way with a controlled stop (`DynamicWalker::stop_early`);
-    /// false when no dynamic walk is under way (the static gait holds at once).
+    /// Ends a dynamic walk under way with a controlled stop (`DynamicWalker::stop_early`). The
+    /// static gait stops only by putting a foot down, which it begins itself (a catch, a step
+    /// taken back): true while it does; otherwise false (the static gait holds at once).
     pub fn stop_early(&mut self, trust_force_sensors: bool) -> bool {
-        self.dynamic.running() && self.dynamic.stop_early(trust_force_sensors)
+        if self.dynamic.running() {
+            self.dynamic.stop_early(trust_force_sensors)
+        } else {
+            self.fallback.putting_foot_down()
+        }
     }
 
     /// Puts the static gait's foot in the air down at once, ending the walk

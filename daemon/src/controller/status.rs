@@ -120,6 +120,10 @@ pub enum FaultCode {
     /// Dynamic gait: a controlled stop could not land its swing foot (no force-torque contact
     /// and the sole not at its foothold's height): the robot holds on one foot.
     StopCouldNotLand,
+    /// Static gait: landing the foot in the air would have taken a deeper crouch of the
+    /// standing leg than `standing_crouch_max_m` (a landing beyond reach); the foot was put
+    /// back where it lifted off, and the robot holds on both feet.
+    StepOutOfReach,
 }
 
 impl FaultCode {
@@ -152,6 +156,11 @@ impl FaultCode {
                 "the controlled stop could not land the swing foot (no contact where its foothold \
                  should be): holding on one foot"
             }
+            Self::StepOutOfReach => {
+                "step out of reach: landing the foot would have taken a deeper crouch of the \
+                 standing leg than standing_crouch_max_m; the foot was put back where it lifted \
+                 off, holding on both feet"
+            }
         }
     }
 
@@ -176,6 +185,7 @@ impl FaultCode {
             Self::MissedTouchdown => "missed_touchdown",
             Self::NotOnBothFeet => "not_on_both_feet",
             Self::StopCouldNotLand => "stop_could_not_land",
+            Self::StepOutOfReach => "step_out_of_reach",
         }
     }
 }
