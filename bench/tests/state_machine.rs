@@ -591,3 +591,75 @@ fn the_estimate_turns_onto_the_imu_heading_no_faster_than_its_bound() {
         assert_eq!(h.closed.controller.status().state, ControllerState::Idle);
     }
 }
+
+/// A stair higher than a gait is set to take (`max_step_up_m`, `max_step_down_m` of
+/// `[controller]` for the static gait, of `[gait.dynamic]` for the dynamic one) is refused
+/// before anything moves, naming the stance, the foot, the height and the key. JVRC-1's dynamic
+/// gait climbs 0.10 m stairs and walks down 0.15 m ones under MuJoCo; up 0.15 m and down 0.185 m
+/// it tipped at the first stair and fell after the fault. Its static gait takes the 10° ramp's
+/// steps, not a 0.10 m stair.
+#[test]
+fn stairs_higher_than_a_gait_takes_are_refused_naming_the_step_and_the_key() {
+    use stance::{AffordanceSet, Gait, PostProcessParams, Scene, WalkRequest};
+    let robot = walk_support::robot("jvrc1");
+    let file = kinematics::ConfigFile::load(&walk_support::config_path("jvrc1")).unwrap();
+    let config = walk_support::controller_config("jvrc1");
+    let gaits = daemon::controller::GaitConfig::from_config(&file).unwrap();
+    let prepare = |scene: &str, gait: Gait| {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/scenes");
+        let scene = Scene::from_path(&path.join(scene)).expect("scene loads");
+        let params = PostProcessParams::from_config_for(&file, gait).unwrap();
+        let request = WalkRequest {
+            distance: scene.path_length(),
+            affordances: AffordanceSet::Feet,
+            seed: 0,
+            speed: None,
+        };
+        let environment = scene.walk_environment();
+        let walk = stance::walk_in(&robot, &params, &request, &environment, |options| {
+            stance::generate(&robot, options)
+        })
+        .expect("walks on the scene");
+        daemon::controller::Controller::prepare_gait(&robot, &config, &gaits, &walk, gait)
+            .map(|_| ())
+            .map_err(|refusal| refusal.to_string())
+    };
+    assert_eq!(prepare("stairs-up-10cm.toml", Gait::Dynamic), Ok(()));
+    assert_eq!(prepare("stairs-down-15cm.toml", Gait::Dynamic), Ok(()));
+    assert_eq!(prepare("ramp-10deg.toml", Gait::Static), Ok(()));
+    for (scene, gait, step, key) in [
+        (
+            "stairs-up-15cm.toml",
+            Gait::Dynamic,
+            "steps up 0.150 m",
+            "[gait.dynamic] max_step_up_m = 0.1,",
+        ),
+        (
+            "stairs-down-18cm.toml",
+            Gait::Dynamic,
+            "steps down 0.185 m",
+            "[gait.dynamic] max_step_down_m = 0.15,",
+        ),
+        (
+            "stairs-up-10cm.toml",
+            Gait::Static,
+            "steps up 0.100 m",
+            "[controller] max_step_up_m = 0.06,",
+        ),
+        (
+            "stairs-down-10cm.toml",
+            Gait::Static,
+            "steps down 0.100 m",
+            "[controller] max_step_down_m = 0.06,",
+        ),
+    ] {
+        let refusal = prepare(scene, gait).expect_err(scene);
+        assert!(
+            refusal.starts_with("sequence refused: stance ")
+                && refusal.contains("foot ")
+                && refusal.contains(step)
+                && refusal.contains(key),
+            "{scene}: {refusal}"
+        );
+    }
+}

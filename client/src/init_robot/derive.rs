@@ -420,6 +420,14 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
         gait_dynamic.push(match *name {
             "single_support_s" => key(name, single, period_rule(0.55)),
             "double_support_s" => key(name, double, period_rule(0.25)),
+            "max_step_up_m" | "max_step_down_m" => {
+                let base = reference::number(&reference::GAIT_DYNAMIC, name);
+                key(
+                    name,
+                    round(base * r, 0.001),
+                    format!("{base} × l/l_ref: higher steps are refused (JVRC-1's, measured)"),
+                )
+            }
             _ => kept(&reference::GAIT_DYNAMIC, name, "JVRC-1's"),
         });
     }
@@ -713,7 +721,11 @@ fn controller(Scales { r, t }: Scales, rules: ControllerRules) -> Vec<Line> {
                      steps are refused"
                 ),
             ),
-            "lift_height_m" | "approach_height_m" => scaled(r, "r"),
+            "lift_height_m"
+            | "approach_height_m"
+            | "max_step_up_m"
+            | "max_step_down_m"
+            | "standing_crouch_max_m" => scaled(r, "r"),
             "com_speed" | "swing_speed" | "lower_speed" => scaled(t, "t"),
             "torso_gain" => match torso_gain {
                 Some((gain, speed)) => key(
@@ -774,6 +786,14 @@ fn controller_heading(key: &str) -> Option<&'static str> {
         "tipping_detection_rad" => {
             "fault (and hold) when the IMU and leg odometry disagree on the base orientation by \
              more than this (rad)"
+        }
+        "max_step_up_m" => {
+            "... or with a higher step up or down in the static gait (docs/scenes.md, \"Step \
+             heights\")"
+        }
+        "standing_crouch_max_m" => {
+            "with a foot in the air (static gait), take the step back when landing it would need \
+             the standing leg to lower the body deeper than this (m)"
         }
         "catch_tilt_rad" => {
             "with a foot in the air (static gait), put it down at once and end the walk in the \

@@ -40,7 +40,7 @@ pub enum Tuned {
 }
 
 /// `configs/jvrc1.toml` `[controller]`, in its order.
-pub const CONTROLLER: [(&str, Tuned); 41] = [
+pub const CONTROLLER: [(&str, Tuned); 44] = [
     ("com_weight", Tuned::Number(10.0)),
     ("foot_weight", Tuned::Number(10.0)),
     ("unload_foot_weight", Tuned::Number(10.0)),
@@ -78,14 +78,17 @@ pub const CONTROLLER: [(&str, Tuned); 41] = [
     ("touchdown_debounce_ticks", Tuned::Integer(3)),
     ("phase_timeout_s", Tuned::Number(5.0)),
     ("max_step_m", Tuned::Number(0.5)),
+    ("max_step_up_m", Tuned::Number(0.06)),
+    ("max_step_down_m", Tuned::Number(0.06)),
     ("command_lead_max_rad", Tuned::Number(0.05)),
     ("tipping_detection_rad", Tuned::Number(0.25)),
     ("catch_tilt_rad", Tuned::Number(0.1)),
+    ("standing_crouch_max_m", Tuned::Number(0.09)),
     ("carry_released_hands", Tuned::Switch(true)),
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic]`, in its order.
-pub const GAIT_DYNAMIC: [(&str, Tuned); 14] = [
+pub const GAIT_DYNAMIC: [(&str, Tuned); 16] = [
     ("single_support_s", Tuned::Number(0.55)),
     ("double_support_s", Tuned::Number(0.25)),
     ("initial_double_support_s", Tuned::Number(1.0)),
@@ -100,6 +103,8 @@ pub const GAIT_DYNAMIC: [(&str, Tuned); 14] = [
     ("hand_weight", Tuned::Number(0.02)),
     ("com_gain", Tuned::Number(3.0)),
     ("torso_posture_weight", Tuned::Number(1.0)),
+    ("max_step_up_m", Tuned::Number(0.1)),
+    ("max_step_down_m", Tuned::Number(0.15)),
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic.stabilizer]`, in its order.

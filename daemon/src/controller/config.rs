@@ -9,6 +9,7 @@ use kinematics::{ConfigFile, ConfigFileError};
 use serde::Deserialize;
 
 use super::gait::force_difference_bounds;
+use super::sequence::StepHeights;
 
 /// The section [`ControllerConfig`] is read from.
 const SECTION: &str = "controller";
@@ -108,6 +109,13 @@ pub struct ControllerConfig {
     pub phase_timeout_s: f64,
     /// Longest step between consecutive contacts of one foot that a sequence may ask for (m).
     pub max_step_m: f64,
+    /// Highest step up between consecutive contacts of one foot the static gait takes (m); a
+    /// sequence with a higher one is refused (docs/scenes.md, "Step heights"). JVRC-1's
+    /// standing knee lifts it up a 0.10 m stair in 1 of 4 walks and tips it in the others.
+    pub max_step_up_m: f64,
+    /// Highest step down the static gait takes (m): JVRC-1 cannot reach a 0.10 m stair's tread
+    /// 0.29 m ahead with its CoM over the standing foot (its steps are taken back).
+    pub max_step_down_m: f64,
     /// How far the integrated joint command may lead the measured angle (rad). The command is
     /// integrated from the previous command, so a loaded joint keeps the servo offset that holds
     /// its load; this bound stops the integral from winding up when a joint is blocked.
@@ -246,6 +254,8 @@ impl Default for ControllerConfig {
             touchdown_debounce_ticks: 3,
             phase_timeout_s: 5.0,
             max_step_m: 0.5,
+            max_step_up_m: 0.06,
+            max_step_down_m: 0.06,
             command_lead_max_rad: 0.05,
             unload_foot_weight: 100.0,
             tipping_detection_rad: 0.25,
@@ -308,6 +318,15 @@ pub enum ConfigError {
 }
 
 impl ControllerConfig {
+    /// The static gait's step heights (`max_step_up_m`, `max_step_down_m`).
+    pub fn step_heights(&self) -> StepHeights {
+        StepHeights {
+            up: self.max_step_up_m,
+            down: self.max_step_down_m,
+            section: "[controller]",
+        }
+    }
+
     /// Reads the `[controller]` section of the robot config file at `path`.
     pub fn from_config_file(path: &Path) -> Result<Self, ConfigError> {
         Self::from_config(&ConfigFile::load(path)?)
@@ -441,6 +460,8 @@ impl ControllerConfig {
             Bound::new("unloaded_max_s", self.unloaded_max_s, 0.002, 1.0),
             Bound::new("phase_timeout_s", self.phase_timeout_s, 0.01, 60.0),
             Bound::new("max_step_m", self.max_step_m, 0.01, 2.0),
+            Bound::new("max_step_up_m", self.max_step_up_m, 0.0, 1.0),
+            Bound::new("max_step_down_m", self.max_step_down_m, 0.0, 1.0),
             Bound::new("command_lead_max_rad", self.command_lead_max_rad, 1e-4, 1.0),
             Bound::new(
                 "tipping_detection_rad",

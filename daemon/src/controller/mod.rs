@@ -60,7 +60,7 @@ use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
 
 pub use config::{ConfigError, ControllerConfig};
 pub use gait::{DynamicGaitConfig, GaitConfig, StabilizerConfig};
-pub use sequence::{PreparedSequence, Refusal};
+pub use sequence::{PreparedSequence, Refusal, StepHeights};
 pub use stance::Gait;
 pub use status::{
     BalanceStatus, ControllerState, ControllerStatus, FaultCode, FaultDescription,
@@ -309,13 +309,14 @@ impl Controller {
         })
     }
 
-    /// Non-RT: validates a post-processed sequence against the robot and config and prepares it.
+    /// Non-RT: validates a post-processed sequence against the robot and config and prepares it
+    /// for the static gait.
     pub fn prepare(
         robot: &Robot,
         config: &ControllerConfig,
         seq: &stance::PostProcessedSequence,
     ) -> Result<PreparedSequence, Refusal> {
-        PreparedSequence::new(robot, config, seq)
+        PreparedSequence::new(robot, config, &config.step_heights(), seq)
     }
 
     /// Non-RT: [`prepare`](Self::prepare) for `gait`; a dynamic walk is also planned here (its
@@ -328,12 +329,13 @@ impl Controller {
         seq: &stance::PostProcessedSequence,
         gait: Gait,
     ) -> Result<PreparedSequence, Refusal> {
-        let mut prepared = PreparedSequence::new(robot, config, seq)?;
-        if gait == Gait::Dynamic {
-            let dynamic = gaits.dynamic().map_err(|e| Refusal(e.to_string()))?;
-            let plan = DynamicPlan::new(robot, &prepared.stances, dynamic)?;
-            prepared.dynamic = Some(Box::new(plan));
-        }
+        let Gait::Dynamic = gait else {
+            return Self::prepare(robot, config, seq);
+        };
+        let dynamic = gaits.dynamic().map_err(|e| Refusal(e.to_string()))?;
+        let mut prepared = PreparedSequence::new(robot, config, &dynamic.step_heights(), seq)?;
+        let plan = DynamicPlan::new(robot, &prepared.stances, dynamic)?;
+        prepared.dynamic = Some(Box::new(plan));
         Ok(prepared)
     }
 

@@ -13,6 +13,7 @@ use kinematics::bounds::{Bound, Number, Range};
 use kinematics::config_file::toml_message;
 
 use crate::controller::config::{ConfigError, check};
+use crate::controller::sequence::StepHeights;
 
 /// What a robot config says about gaits. Without a `[gait]` section a robot walks statically
 /// only.
@@ -107,6 +108,13 @@ pub struct DynamicGaitConfig {
     /// the body walked on, the stance sole rolled onto a corner and turned about it, and walks
     /// with a held hand fell. Absent: the `[controller]` value.
     pub torso_posture_weight: Option<f64>,
+    /// Highest step up between consecutive contacts of one foot the dynamic gait takes (m); a
+    /// sequence with a higher one is refused (docs/scenes.md, "Step heights"). JVRC-1 climbs
+    /// 0.10 m stairs 10/10 under MuJoCo and tips at the first 0.15 m one.
+    pub max_step_up_m: f64,
+    /// Highest step down the dynamic gait takes (m): JVRC-1 walks down 0.15 m stairs 10/10 and
+    /// tips at the first 0.185 m one, its trailing knee at its torque limit.
+    pub max_step_down_m: f64,
     /// The stabilizer closing the loop on force-torque and IMU.
     #[serde(skip)]
     pub stabilizer: StabilizerConfig,
@@ -166,6 +174,8 @@ impl Default for DynamicGaitConfig {
             com_gain: Some(DYNAMIC_COM_GAIN),
             zmp_inward_offset_m: 0.0,
             torso_posture_weight: Some(1.0),
+            max_step_up_m: 0.10,
+            max_step_down_m: 0.15,
             stabilizer: StabilizerConfig::default(),
         }
     }
@@ -361,6 +371,15 @@ fn deserialize<T: serde::de::DeserializeOwned>(
 }
 
 impl DynamicGaitConfig {
+    /// The dynamic gait's step heights (`max_step_up_m`, `max_step_down_m`).
+    pub fn step_heights(&self) -> StepHeights {
+        StepHeights {
+            up: self.max_step_up_m,
+            down: self.max_step_down_m,
+            section: "[gait.dynamic]",
+        }
+    }
+
     /// The single support of a step up or down (`step_single_support_s` or its default).
     pub fn step_single_support(&self) -> f64 {
         self.step_single_support_s
@@ -474,6 +493,8 @@ impl DynamicGaitConfig {
             Bound::optional("com_gain", self.com_gain, 0.01, 1000.0),
             Bound::new("zmp_inward_offset_m", self.zmp_inward_offset_m, 0.0, 0.2),
             Bound::optional("torso_posture_weight", self.torso_posture_weight, 1e-6, 1e6),
+            Bound::new("max_step_up_m", self.max_step_up_m, 0.0, 1.0),
+            Bound::new("max_step_down_m", self.max_step_down_m, 0.0, 1.0),
         ]
     }
 }
