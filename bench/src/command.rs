@@ -20,9 +20,9 @@ use kinematics::ConfigFile;
 use kinematics::robot::Robot;
 use shm_types::RuntimeConfig;
 use stance::learned::SourceArgs;
-use stance::{AffordanceSet, Gait, PostProcessParams, PostProcessedSequence, WalkRequest};
+use stance::{AffordanceSet, Gait, PostProcessParams, PostProcessedSequence, Scene, WalkRequest};
 
-use crate::sequence;
+use crate::sequence::{self, SequenceError};
 use crate::walk::{Outcome, WalkOptions, WalkReport, kinematic_gaits, walk};
 
 /// Control rate when neither `--rate-hz` nor `[runtime] rate_hz` gives one (Hz).
@@ -69,7 +69,7 @@ pub struct BenchArgs {
     #[arg(
         long,
         value_name = "D",
-        required_unless_present = "sequence",
+        required_unless_present_any = ["sequence", "scene"],
         value_parser = DISTANCE_M.parser()
     )]
     pub distance: Option<f64>,
@@ -86,6 +86,11 @@ pub struct BenchArgs {
     pub postprocess: bool,
     #[command(flatten)]
     pub source: SourceArgs,
+    /// Walk through this scene (docs/scenes.md) from its start to its goal: the distance is the
+    /// path's length, and the kinematic simulator stands the feet on its surfaces (its railings
+    /// are not modelled).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["distance", "sequence"])]
+    pub scene: Option<PathBuf>,
     /// Support affordances: feet, feet+left-hand or feet+right-hand.
     #[arg(long, value_name = "SET", default_value = "feet")]
     pub affordances: AffordanceSet,
@@ -212,6 +217,27 @@ fn bench_sequence(
     robot: &Robot,
     params: PostProcessParams,
 ) -> anyhow::Result<(PostProcessedSequence, String)> {
+    if let Some(path) = &args.scene {
+        let scene = Scene::from_path(path)?;
+        let source = args.source.load()?;
+        let request = WalkRequest {
+            distance: scene.path_length(),
+            affordances: args.affordances,
+            seed: args.seed,
+            speed: None,
+        };
+        let walk = source
+            .walk_in(robot, &params, &request, &scene.walk_environment())
+            .map_err(SequenceError::Walk)?;
+        let origin = format!(
+            "scene {} ({:.2} m), affordances {}, source {}",
+            path.display(),
+            request.distance,
+            args.affordances,
+            source.describe(args.seed)
+        );
+        return Ok((walk, origin));
+    }
     Ok(match (&args.sequence, args.distance) {
         (Some(path), _) => (
             sequence::from_file(robot, params, path, args.postprocess)?,

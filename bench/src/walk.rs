@@ -12,6 +12,7 @@ use daemon::controller::{
 use kinematic_sim::{KinematicSim, SafetySummary, SimMeasurement, SimOptions};
 use kinematics::ConfigFile;
 use kinematics::robot::Robot;
+use sim_adapter::SceneGround;
 use stance::PostProcessedSequence;
 
 use crate::closed_loop::{ClosedLoop, TickError, feet_midpoint};
@@ -131,7 +132,8 @@ pub enum WalkError {
 }
 
 /// Executes `sequence` on `robot` (starting from its standing posture) in closed loop with the
-/// kinematic simulator; `observe` sees every tick.
+/// kinematic simulator, on the surfaces it was post-processed on (a scene's stairs and ramps);
+/// `observe` sees every tick.
 pub fn walk(
     robot: Arc<Robot>,
     config: ControllerConfig,
@@ -147,8 +149,15 @@ pub fn walk(
         judge_by_zmp: options.gait == Gait::Dynamic,
         ..SimOptions::default()
     };
-    let sim = KinematicSim::with_options(robot.clone(), robot.standing.clone(), sim_options)
-        .map_err(|e| WalkError::Loop(format!("simulator: {e}")))?;
+    // A sequence post-processed onto a scene's surfaces walks on them.
+    let environment = sequence.environment();
+    let sim = if environment.is_flat_ground() {
+        KinematicSim::with_options(robot.clone(), robot.standing.clone(), sim_options)
+    } else {
+        let ground = Arc::new(SceneGround::new(environment.clone()));
+        KinematicSim::on_ground(robot.clone(), robot.standing.clone(), sim_options, ground)
+    }
+    .map_err(|e| WalkError::Loop(format!("simulator: {e}")))?;
     let mut closed = ClosedLoop::new(controller, sim, options.rate_hz);
     let max_ticks = (options.time_limit_s * options.rate_hz).ceil() as u64;
     let start_midpoint = feet_midpoint(&closed.sim);

@@ -392,3 +392,58 @@ fn a_paced_learned_walk_is_planned_from_its_stance_durations() {
         }
     }
 }
+
+/// The kinematic simulator stands the feet on the surfaces a sequence was post-processed on
+/// (`sim_adapter::SceneGround`): JVRC-1's dynamic gait climbs the ten 0.10 m stairs of
+/// `stairs-up-10cm.toml` to its top landing, both feet on every stair, its CoM ending 1 m higher
+/// than it started. On the flat plane of before, the walk fell at the first stair (its feet
+/// planned onto treads the simulator did not have).
+#[test]
+fn a_dynamic_walk_climbs_stairs_in_the_kinematic_simulator() {
+    let robot = walk_support::robot("jvrc1");
+    let file = kinematics::ConfigFile::load(&config_path("jvrc1")).unwrap();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../configs/scenes/stairs-up-10cm.toml");
+    let scene = stance::Scene::from_path(&path).expect("scene loads");
+    let params = PostProcessParams::from_config_for(&file, Gait::Dynamic).unwrap();
+    let request = WalkRequest {
+        distance: scene.path_length(),
+        affordances: stance::AffordanceSet::Feet,
+        seed: 0,
+        speed: None,
+    };
+    let sequence = stance::walk_in(
+        &robot,
+        &params,
+        &request,
+        &scene.walk_environment(),
+        |options| stance::generate(&robot, options),
+    )
+    .expect("walks on the scene");
+    let options = WalkOptions {
+        gait: Gait::Dynamic,
+        gaits: kinematic_gait_config("jvrc1"),
+        ..WalkOptions::default()
+    };
+    let mut com_heights = (f64::NAN, f64::NAN);
+    let report = walk(
+        robot.clone(),
+        controller_config("jvrc1"),
+        &sequence,
+        &options,
+        |o| {
+            if o.tick == 0 {
+                com_heights.0 = o.sim.com.z;
+            }
+            com_heights.1 = o.sim.com.z;
+        },
+    )
+    .expect("runs");
+    assert_eq!(report.outcome, Outcome::Done, "{:?}", report.safety);
+    let climbed = com_heights.1 - com_heights.0;
+    assert!(
+        (climbed - 1.0).abs() < 0.02,
+        "the CoM climbed {climbed:.3} m"
+    );
+    assert!(report.safety.max_penetration < 0.005, "{:?}", report.safety);
+}

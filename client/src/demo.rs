@@ -236,15 +236,10 @@ pub fn walk_sequence(
     )?)
 }
 
-/// The scene of `--scene`, refused before anything starts when the simulator cannot model it.
-pub fn load_scene(path: Option<&Path>, physics: Physics) -> anyhow::Result<Option<Scene>> {
-    let Some(path) = path else {
-        return Ok(None);
-    };
-    if physics != Physics::Mujoco {
-        bail!("--scene needs --physics mujoco: the kinematic simulator does not model terrain yet");
-    }
-    Ok(Some(Scene::from_path(path)?))
+/// The scene of `--scene`, refused before anything starts when it does not validate. Both
+/// simulators model its surfaces; only MuJoCo models its railings.
+pub fn load_scene(path: Option<&Path>) -> anyhow::Result<Option<Scene>> {
+    path.map(Scene::from_path).transpose().map_err(Into::into)
 }
 
 /// Runs the demo and returns what it measured (also used by the e2e tests).
@@ -262,7 +257,7 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
         .clone()
         .unwrap_or(runtime.service_prefix);
     let robot = std::sync::Arc::new(Robot::from_config(&file, args.urdf.as_deref())?);
-    let scene = load_scene(args.scene.as_deref(), args.physics)?;
+    let scene = load_scene(args.scene.as_deref())?;
     let source = args.source.load()?;
     let params = stance::PostProcessParams::from_config_for(&file, gait)?;
     let request = WalkRequest {
@@ -417,15 +412,14 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_scene_is_refused_without_mujoco_and_loaded_with_it() {
-        let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/scenes/ramp-10deg.toml");
-        let error = load_scene(Some(&scene), Physics::Kinematic).unwrap_err();
-        assert!(
-            error.to_string().contains("--scene needs --physics mujoco"),
-            "{error}"
-        );
-        let loaded = load_scene(Some(&scene), Physics::Mujoco).unwrap().unwrap();
+    fn a_scene_is_loaded_for_either_simulator_and_a_bad_one_refused() {
+        let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/scenes");
+        let loaded = load_scene(Some(&scenes.join("ramp-10deg.toml")))
+            .unwrap()
+            .unwrap();
         assert_eq!(loaded.name, "ramp-10deg");
-        assert!(load_scene(None, Physics::Kinematic).unwrap().is_none());
+        assert!(load_scene(None).unwrap().is_none());
+        let error = load_scene(Some(&scenes.join("missing.toml"))).unwrap_err();
+        assert!(error.to_string().contains("missing.toml"), "{error}");
     }
 }

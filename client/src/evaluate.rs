@@ -369,7 +369,7 @@ impl<'a> Subject<'a> {
 /// `walkctl evaluate`: runs the matrix, prints the table or JSON, writes the plots; fails unless
 /// every run succeeded.
 pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
-    let scene = crate::demo::load_scene(args.scene.as_deref(), args.physics)?;
+    let scene = crate::demo::load_scene(args.scene.as_deref())?;
     let requests = match &scene {
         Some(scene) => MatrixCells {
             distances: vec![scene.path_length()],

@@ -8,9 +8,10 @@
 //!   solutions weighted by each foot's lever-rule share of the weight, faded out as a foot is
 //!   lifted towards release. A foot in contact therefore stays where it is up to the
 //!   inconsistency of the command, which is reported as slip.
-//! - **Contacts** are derived from kinematics: a free foot touches down when its lowest sole corner
-//!   reaches the ground; an anchored foot is released when lifted more than a tolerance above its
-//!   anchor. Hands carry no load (the ground is the only support surface modelled).
+//! - **Contacts** are derived from kinematics: a free foot touches down when a sole corner reaches
+//!   the ground under it; an anchored foot is released when lifted more than a tolerance above
+//!   its anchor. The ground is a plane, or a scene's support surfaces ([`Ground`]: stairs, ramps).
+//!   Hands carry no load (railings are not modelled).
 //! - **Force-torque readings** come from static equilibrium: the weight `m·g` is split between the
 //!   feet in contact by the lever rule on the CoM ground projection, plus a stiff ground
 //!   compliance that moves load onto a foot pressed into the ground; the wrench is expressed at
@@ -40,10 +41,18 @@ use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
 
 const FEET: [EndEffector; 2] = [EndEffector::LeftFoot, EndEffector::RightFoot];
 
+/// The support surfaces a walk stands on, beyond the flat plane of [`SimOptions::ground_height`]
+/// (a scene's stairs and ramps, [`KinematicSim::on_ground`]).
+pub trait Ground: std::fmt::Debug + Send + Sync {
+    /// Height (m, world z) of the highest support surface under (`x`, `y`); `None` where there is
+    /// none (a foot there finds nothing to land on).
+    fn height_at(&self, x: f64, y: f64) -> Option<f64>;
+}
+
 /// Tunable contact model; the defaults suit the vendored humanoids.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimOptions {
-    /// Height of the ground plane (m).
+    /// Height of the ground plane (m), unless the simulator stands on a [`Ground`].
     pub ground_height: f64,
     /// A free foot touches down when its lowest sole corner is this close to the ground (m).
     pub touchdown_tolerance: f64,
@@ -261,6 +270,8 @@ fn blend(candidates: &[Option<Isometry3<f64>>; 2], shares: &[f64; 2]) -> Option<
 pub struct KinematicSim {
     robot: Arc<Robot>,
     options: SimOptions,
+    /// The support surfaces; `None`: the plane at `options.ground_height`.
+    ground: Option<Arc<dyn Ground>>,
     configuration: Configuration,
     kinematics: Kinematics,
     anchors: [Option<Isometry3<f64>>; 2],
@@ -297,6 +308,25 @@ impl KinematicSim {
         initial: Configuration,
         options: SimOptions,
     ) -> Result<Self, SimError> {
+        Self::start(robot, initial, options, None)
+    }
+
+    /// [`KinematicSim::with_options`] on `ground`'s support surfaces instead of the plane.
+    pub fn on_ground(
+        robot: Arc<Robot>,
+        initial: Configuration,
+        options: SimOptions,
+        ground: Arc<dyn Ground>,
+    ) -> Result<Self, SimError> {
+        Self::start(robot, initial, options, Some(ground))
+    }
+
+    fn start(
+        robot: Arc<Robot>,
+        initial: Configuration,
+        options: SimOptions,
+        ground: Option<Arc<dyn Ground>>,
+    ) -> Result<Self, SimError> {
         let mut kinematics = Kinematics::new(&robot.model);
         kinematics.update(&robot.model, &initial);
         let measurement = SimMeasurement::at_rest(&initial, kinematics.com());
@@ -304,6 +334,7 @@ impl KinematicSim {
         let mut sim = Self {
             robot,
             options,
+            ground,
             configuration: initial,
             kinematics,
             anchors: [None, None],
@@ -360,12 +391,20 @@ impl KinematicSim {
             .frame_pose(&self.robot.model, self.robot.frame(e))
     }
 
+    /// Height of the ground under (`x`, `y`): minus infinity off every surface.
+    fn ground_height_at(&self, x: f64, y: f64) -> f64 {
+        match &self.ground {
+            Some(ground) => ground.height_at(x, y).unwrap_or(f64::NEG_INFINITY),
+            None => self.options.ground_height,
+        }
+    }
+
+    /// Height of `foot`'s lowest sole corner above the ground under it (negative: below it).
     fn lowest_corner_height(&self, foot: EndEffector) -> f64 {
         sole_corners(&self.pose(foot), &self.robot.sole)
             .iter()
-            .map(|c| c.z)
+            .map(|c| c.z - self.ground_height_at(c.x, c.y))
             .fold(f64::INFINITY, f64::min)
-            - self.options.ground_height
     }
 
     /// Lever-rule share of the weight carried by each anchored foot when the resultant acts at
@@ -476,7 +515,13 @@ impl KinematicSim {
             return (*com, mass * GRAVITY);
         }
         let acceleration = self.com_acceleration;
-        let height = com.z - self.options.ground_height;
+        let ground = self.ground_height_at(com.x, com.y);
+        let height = com.z
+            - if ground.is_finite() {
+                ground
+            } else {
+                self.options.ground_height
+            };
         // The ground carries m (g + z̈); with none to carry (the CoM falling faster than g) the
         // feet are unloaded and the ZMP is undefined: keep it under the CoM.
         let support = GRAVITY + acceleration.z;

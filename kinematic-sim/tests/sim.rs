@@ -347,3 +347,40 @@ fn a_setpoint_applied_again_is_a_missed_command_not_a_stop() {
         );
     }
 }
+
+/// A ground that is a surface at `height` where y > 0 (under the left foot) and nothing
+/// elsewhere.
+#[derive(Debug)]
+struct LeftSideOnly {
+    height: f64,
+}
+
+impl kinematic_sim::Ground for LeftSideOnly {
+    fn height_at(&self, _x: f64, y: f64) -> Option<f64> {
+        (y > 0.0).then_some(self.height)
+    }
+}
+
+/// On a [`kinematic_sim::Ground`] a foot stands where a surface is under its sole: with a surface
+/// under the left foot only, the left foot is anchored and the right has nothing to stand on; a
+/// surface 5 cm above the soles is 5 cm of penetration; one 5 cm below them holds nothing up.
+#[test]
+fn feet_stand_on_the_ground_under_them() {
+    let robot = robot("jvrc1");
+    let on = |height: f64| {
+        KinematicSim::on_ground(
+            robot.clone(),
+            robot.standing.clone(),
+            SimOptions::default(),
+            Arc::new(LeftSideOnly { height }),
+        )
+    };
+    let sim = on(0.0).expect("the left foot stands");
+    assert_eq!(sim.measurement().contacts, [true, false, false, false]);
+    let sim = on(0.05).expect("the left foot stands, sunk in");
+    assert!((sim.measurement().safety.penetration - 0.05).abs() < 1e-3);
+    match on(-0.05) {
+        Err(SimError::NotStanding { lowest_m }) => assert!((lowest_m - 0.05).abs() < 1e-3),
+        other => panic!("stood on nothing: {:?}", other.map(|_| ())),
+    }
+}

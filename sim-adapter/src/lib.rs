@@ -13,6 +13,7 @@
 mod adapter_loop;
 pub mod inject;
 mod robot_io;
+mod scene_ground;
 mod simulated;
 mod truth;
 
@@ -22,5 +23,6 @@ pub mod mujoco;
 
 pub use adapter_loop::{AdapterError, AdapterOptions, AdapterReport, run_adapter};
 pub use robot_io::RobotIo;
+pub use scene_ground::SceneGround;
 pub use simulated::{MotorLoad, SimulatedRobot, TerrainContacts};
 pub use truth::{GroundTruth, PublishTruth};

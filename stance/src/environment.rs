@@ -210,6 +210,15 @@ impl Environment {
             .min_by(|(_, a), (_, b)| (point.z - a).abs().total_cmp(&(point.z - b).abs()))
     }
 
+    /// The elevation (world z) of the highest surface over `(x, y)`; `None` if none covers it.
+    /// What a sole corner there stands on (a stair's tread, not the floor under it).
+    pub fn highest_at(&self, x: f64, y: f64) -> Option<f64> {
+        self.surfaces
+            .iter()
+            .filter_map(|s| s.elevation_at(x, y))
+            .max_by(f64::total_cmp)
+    }
+
     /// The highest surface (world z) under the horizontal segment from `from` to `to`; `None`
     /// if it passes over none. What a swing foot passing there must clear (pass 9).
     pub fn highest_under(&self, from: &Vector3<f64>, to: &Vector3<f64>) -> Option<f64> {

@@ -12,9 +12,9 @@
 //! With `--inject` (evaluation of the controlled stop, `sim_adapter::inject`) it reports one bad
 //! sample, withholds a touchdown or asks walkd for a hold or abort, `--inject-delay` seconds of
 //! simulated time after the `--inject-step`-th lift-off of a foot.
-//! With `--scene` (MuJoCo only) the world is the scene's terrain (docs/scenes.md,
-//! `sim_adapter::mujoco::Terrain`) instead of the flat floor, and the robot starts standing at the
-//! scene's start.
+//! With `--scene` the world is the scene's terrain (docs/scenes.md; MuJoCo:
+//! `sim_adapter::mujoco::Terrain`, its surfaces and railings; kinematic: `sim_adapter::SceneGround`,
+//! its surfaces) instead of the flat floor, and the robot starts standing at the scene's start.
 //! With `--snapshots` (MuJoCo only, feature `render`) it saves a side view of the robot every
 //! `--snapshot-period` of simulated time (`sim_adapter::mujoco::render`).
 //! Besides the adapter side of the contract it publishes the simulator's ground truth (CoM,
@@ -32,6 +32,7 @@ use clap::Parser;
 use kinematic_sim::{KinematicSim, SimOptions, Simulator};
 use kinematics::ConfigFile;
 use kinematics::bounds::Range;
+use kinematics::configuration::Configuration;
 use kinematics::robot::Robot;
 use shm_types::process::{
     InjectedFault, Physics, exit_code, install_termination_handler, termination_requested,
@@ -42,7 +43,8 @@ use shm_types::{
 };
 use sim_adapter::inject::{FaultInjector, FaultPlan};
 use sim_adapter::{
-    AdapterOptions, MotorLoad, PublishTruth, SimulatedRobot, TerrainContacts, run_adapter,
+    AdapterOptions, MotorLoad, PublishTruth, SceneGround, SimulatedRobot, TerrainContacts,
+    run_adapter,
 };
 
 /// Simulated robot for walkd: publishes sensor samples, applies joint commands.
@@ -72,8 +74,9 @@ struct Args {
     /// support polygon by design).
     #[arg(long)]
     judge_by_zmp: bool,
-    /// `--physics mujoco`: build the world from this scene file (docs/scenes.md) instead of the
-    /// flat floor, and stand the robot at the scene's start.
+    /// Build the world from this scene file (docs/scenes.md) instead of the flat floor, and
+    /// stand the robot at the scene's start (the kinematic simulator models its surfaces, not
+    /// its railings).
     #[arg(long, value_name = "FILE")]
     scene: Option<PathBuf>,
     /// `--physics mujoco`: save a picture of the robot (MuJoCo's offscreen renderer, EGL) every
@@ -165,20 +168,28 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
         Robot::from_config(&file, args.urdf.as_deref()).map_err(|e| config_error(e.into()))?;
     let robot = Arc::new(robot);
     match args.physics {
-        Physics::Kinematic if args.scene.is_some() => Err((
-            exit_code::USAGE,
-            anyhow::anyhow!(
-                "--scene needs --physics mujoco: the kinematic simulator does not model terrain yet"
-            ),
-        )),
         Physics::Kinematic => {
             let standing = robot.standing.clone();
             let options = SimOptions {
                 judge_by_zmp: args.judge_by_zmp,
                 ..SimOptions::default()
             };
-            let sim = KinematicSim::with_options(robot, standing, options)
-                .map_err(|e| config_error(anyhow::Error::from(e).context("standing posture")))?;
+            // On a scene the robot stands at its start on its surfaces, as under MuJoCo (its
+            // railings are not modelled).
+            let sim = match &args.scene {
+                None => KinematicSim::with_options(robot, standing, options),
+                Some(path) => {
+                    let scene =
+                        stance::Scene::from_path(path).map_err(|e| config_error(e.into()))?;
+                    let at_start = Configuration {
+                        base: scene.start * standing.base,
+                        joints: standing.joints,
+                    };
+                    let ground = Arc::new(SceneGround::new(scene.environment));
+                    KinematicSim::on_ground(robot, at_start, options, ground)
+                }
+            }
+            .map_err(|e| config_error(anyhow::Error::from(e).context("standing posture")))?;
             serve(&runtime, args, SimulatedRobot::new(sim))
         }
         Physics::Mujoco if args.judge_by_zmp => Err((
