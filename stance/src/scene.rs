@@ -31,6 +31,8 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector2, Vector3};
 use serde::Deserialize;
 
+use kinematics::configuration::Configuration;
+
 use crate::environment::{Environment, HandAffordance, SupportSurface};
 
 /// The scene format version this build reads; a file with another `format_version` is refused
@@ -353,6 +355,16 @@ impl Scene {
                     ..railing.clone()
                 })
                 .collect(),
+        }
+    }
+
+    /// `posture`, a configuration standing at the origin (the soles' midpoint there, as
+    /// `Robot::standing` is), moved to the scene's start: at its (x, y), turned by its yaw, on
+    /// the surface under it. Both simulators stand the robot there.
+    pub fn place(&self, posture: &Configuration) -> Configuration {
+        Configuration {
+            base: self.start * posture.base,
+            joints: posture.joints.clone(),
         }
     }
 

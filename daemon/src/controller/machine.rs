@@ -429,9 +429,13 @@ impl StateMachine {
         }
         let budget = self.config.standing_crouch_max_m;
         let sink = self.release_com_height - feedback.com.z;
+        if sink <= budget / 2.0 {
+            return false;
+        }
+        // Only now look ahead for the foothold (a scan of the stances).
         let to_descend =
             (feedback.poses[foot as usize].translation.z - self.landing_height(foot)).max(0.0);
-        sink > budget / 2.0 && sink + to_descend > budget
+        sink + to_descend > budget
     }
 
     /// Takes the step back (`standing_leg_gives_way`): the foot rises straight up above both the

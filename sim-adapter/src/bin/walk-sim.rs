@@ -32,7 +32,6 @@ use clap::Parser;
 use kinematic_sim::{KinematicSim, SimOptions, Simulator};
 use kinematics::ConfigFile;
 use kinematics::bounds::Range;
-use kinematics::configuration::Configuration;
 use kinematics::robot::Robot;
 use shm_types::process::{
     InjectedFault, Physics, exit_code, install_termination_handler, termination_requested,
@@ -181,10 +180,7 @@ fn run(args: &Args) -> Result<(), (u8, anyhow::Error)> {
                 Some(path) => {
                     let scene =
                         stance::Scene::from_path(path).map_err(|e| config_error(e.into()))?;
-                    let at_start = Configuration {
-                        base: scene.start * standing.base,
-                        joints: standing.joints,
-                    };
+                    let at_start = scene.place(&standing);
                     let ground = Arc::new(SceneGround::new(scene.environment));
                     KinematicSim::on_ground(robot, at_start, options, ground)
                 }

@@ -109,14 +109,9 @@ impl Terrain {
         &self.scene
     }
 
-    /// `posture`, a configuration standing on the floor at the origin (the soles' midpoint at
-    /// the origin, as `Robot::standing` is), moved to the scene's start: at its (x, y), turned
-    /// by its yaw, on the surface under it.
+    /// `posture` stood at the scene's start ([`Scene::place`]).
     pub fn place(&self, posture: &Configuration) -> Configuration {
-        Configuration {
-            base: self.scene.start * posture.base,
-            joints: posture.joints.clone(),
-        }
+        self.scene.place(posture)
     }
 
     /// Elevation (world z) of the terrain under `(x, y)`: the highest surface there, else the
@@ -124,10 +119,8 @@ impl Terrain {
     pub fn elevation_at(&self, x: f64, y: f64) -> f64 {
         self.scene
             .environment
-            .surfaces
-            .iter()
-            .filter_map(|surface| surface.elevation_at(x, y))
-            .fold(self.base, f64::max)
+            .highest_at(x, y)
+            .map_or(self.base, |z| z.max(self.base))
     }
 
     /// World z of the floor plane and of the boxes' bottom: [`DEPTH_BELOW`] under the lowest
