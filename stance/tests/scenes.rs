@@ -58,6 +58,7 @@ fn every_committed_scene_loads() {
     names.sort();
     let expected = [
         "railing",
+        "railing-left",
         "ramp-10deg",
         "ramp-15deg",
         "stairs-down-10cm",

@@ -411,12 +411,10 @@ impl StateMachine {
     }
 
     /// The standing leg would have to crouch deeper than `standing_crouch_max_m` to land the foot
-    /// in the air: the CoM sank more than half that below its height at the release, and that
-    /// sink plus what the foot still has to descend to its foothold (a foot at full reach comes
-    /// down only as far as the body does) exceeds it. A landing beyond the swing leg's reach
-    /// makes the QP lower the body on the standing knee to bring the foot down: JVRC-1 down a
-    /// 10 cm stair, 0.29 m ahead, sank with the foot until its knee gave way 8 cm down and it
-    /// fell (MuJoCo), where ARMAR-4 lands the same step 11 cm down.
+    /// in the air ([`landing_beyond_crouch`]). A landing beyond the swing leg's reach makes the QP
+    /// lower the body on the standing knee to bring the foot down: JVRC-1 down a 10 cm stair,
+    /// 0.29 m ahead, sank with the foot until its knee gave way 8 cm down and it fell (MuJoCo),
+    /// where ARMAR-4 lands the same step 11 cm down.
     fn standing_leg_gives_way(&self, feedback: &Feedback) -> bool {
         let step = self.current_step();
         let Some(foot) = step.end_effector.filter(|e| e.is_foot()) else {
@@ -427,15 +425,14 @@ impl StateMachine {
         {
             return false;
         }
-        let budget = self.config.standing_crouch_max_m;
         let sink = self.release_com_height - feedback.com.z;
-        if sink <= budget / 2.0 {
+        if sink <= self.config.standing_crouch_max_m / 2.0 {
             return false;
         }
         // Only now look ahead for the foothold (a scan of the stances).
         let to_descend =
             (feedback.poses[foot as usize].translation.z - self.landing_height(foot)).max(0.0);
-        sink + to_descend > budget
+        landing_beyond_crouch(sink, to_descend, &self.config)
     }
 
     /// Takes the step back (`standing_leg_gives_way`): the foot rises straight up above both the
@@ -982,6 +979,20 @@ impl StateMachine {
     }
 }
 
+/// Whether landing a foot takes the standing leg deeper than `standing_crouch_max_m`: the CoM
+/// sank `sink` (m) more than half that below its height at the release, and that sink plus what
+/// the foot still has to descend to its foothold's level, `to_descend` (a foot at full reach
+/// comes down only as far as the body does), exceeds it, with the foot still more than
+/// `approach_height_m + position_tolerance_m` above that level. A foot that low is landing, not
+/// out of reach: JVRC-1 leaning on a railing sank 8.8 cm on its stance hip (at its torque
+/// limit) with the swing foot 2 mm above the ground; taking that foot back up and back made
+/// it tip and fall where landing it walked on (MuJoCo, `railing.toml`, right hand, seed 0).
+fn landing_beyond_crouch(sink: f64, to_descend: f64, config: &ControllerConfig) -> bool {
+    let budget = config.standing_crouch_max_m;
+    let landing = config.approach_height_m + config.position_tolerance_m;
+    sink > budget / 2.0 && to_descend > landing && sink + to_descend > budget
+}
+
 /// The static gait's force-difference control in double support (Kajita et al. 2010; the
 /// dynamic gait's, `gait::force_difference_velocities`), as velocities of the feet (left,
 /// right): they move vertically against each other until their normal forces `forces` (N)
@@ -1057,6 +1068,25 @@ mod tests {
             rise: -0.1,
         };
         assert!((down.height(2.0, 2.0).height - 0.75).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_landing_is_taken_back_only_when_the_foot_is_still_above_its_approach() {
+        // JVRC-1's: bound 0.09 m, lowered from 0.02 m above the foothold, 5 mm tolerance.
+        let config = ControllerConfig::default();
+        let (budget, approach) = (config.standing_crouch_max_m, config.approach_height_m);
+        assert_eq!((budget, approach), (0.09, 0.02));
+        let beyond = |sink, to_descend| landing_beyond_crouch(sink, to_descend, &config);
+        // Down a 10 cm stair out of reach: taken back once half the bound has sunk.
+        assert!(beyond(0.046, 0.086));
+        assert!(!beyond(0.044, 0.086), "less than half the bound sunk");
+        assert!(!beyond(0.05, 0.035), "the sum within the bound");
+        // A sagging stance leg with the foot at or just above its approach: landed, not taken
+        // back, however deep the sink.
+        assert!(!beyond(0.088, 0.002));
+        assert!(!beyond(0.105, 0.020));
+        assert!(!beyond(0.105, 0.025));
+        assert!(beyond(0.105, 0.026));
     }
 
     #[test]
