@@ -265,6 +265,10 @@ pub struct RunResult {
     /// The held hands' mean vertical force over the robot's weight while a hand is planned in
     /// contact, from the simulator's contact forces; `None` without a held hand.
     pub hand_support_share: Option<f64>,
+    /// The force walkd asked of the held hands over the same time, from its telemetry, divided
+    /// by the robot's weight: the desired split beside the measured one; `None` when it held no
+    /// hand then.
+    pub hand_support_asked: Option<f64>,
     /// The walking speed asked of the walk (m/s), if any.
     pub requested_speed_m_s: Option<f64>,
     /// The dynamic gait's planned phases, from walkd's telemetry; `None` for the static gait.
@@ -316,6 +320,7 @@ impl RunResult {
             "foothold_error_m": self.steps.foothold_error_m,
             "edge_clearance_m": self.steps.edge_clearance_m,
             "hand_support_share": self.hand_support_share,
+            "hand_support_asked": self.hand_support_asked,
             "reaches_given_up": r.reaches_given_up,
             "requested_speed_m_s": self.requested_speed_m_s,
             "timing": self.timing,
@@ -654,6 +659,7 @@ fn run_once(
     )
     .context("no simulator truth recorded")?;
     let contacts: Vec<_> = (0..sequence.len()).map(|i| sequence.contacts(i)).collect();
+    let weight_n = model.model.total_mass() * kinematics::ground::GRAVITY;
     let hand_support_share = hands::support_share(
         &contacts,
         walk.trace
@@ -661,8 +667,9 @@ fn run_once(
             .map(|sample| sample.stance_index)
             .zip(walk.status_times.iter().copied()),
         &walk.states,
-        model.model.total_mass() * kinematics::ground::GRAVITY,
+        weight_n,
     );
+    let hand_support_asked = hands::asked_share(&contacts, &walk.hands_asked, weight_n);
     // Through a scene a walk must also land on its footholds (its treads).
     let (success, outcome) = footholds::judged_on_terrain(
         scene.is_some() && stop.is_none(),
@@ -704,6 +711,7 @@ fn run_once(
         stop,
         steps,
         hand_support_share,
+        hand_support_asked,
         requested_speed_m_s: request.speed.map(|speed| speed.m_s),
         timing: TimingReport::of(&walk.phases),
     })
@@ -712,7 +720,7 @@ fn run_once(
 fn row(result: &RunResult) -> String {
     let r = &result.record;
     format!(
-        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {}{} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{} {}{}{}{}",
+        "{:<8} {:<7} {:<16} {:>5.1} m run {:>2}: {:<5} {:<40} sim {:>7.2} s wall {:>7.2} s (×{:.1}) walked {:.3} m at {}{} final error {:.4} m drift {} max tilt {:.3} rad stance {}/{} {}{}{}{}{}",
         result.robot,
         result.gait.name(),
         r.affordances.name(),
@@ -739,6 +747,9 @@ fn row(result: &RunResult) -> String {
         result
             .hand_support_share
             .map_or_else(String::new, |share| format!(" hand share {share:.3}")),
+        result
+            .hand_support_asked
+            .map_or_else(String::new, |asked| format!(" (asked {asked:.3})")),
         r.actuators
             .as_ref()
             .map_or_else(String::new, |a| format!(" {}", a.describe())),
@@ -817,15 +828,24 @@ fn summary(results: &[RunResult]) -> String {
             }
             let shares: Vec<f64> = runs.iter().filter_map(|r| r.hand_support_share).collect();
             if !shares.is_empty() {
+                let asked: Vec<f64> = runs.iter().filter_map(|r| r.hand_support_asked).collect();
                 let _ = writeln!(
                     out,
-                    "{:<8} {:<16} {:>6.1} m  hand support share mean {:.3}, min {:.3}, max {:.3}",
+                    "{:<8} {:<16} {:>6.1} m  hand support share mean {:.3}, min {:.3}, max {:.3}{}",
                     "",
                     "",
                     group.distance_m,
                     shares.iter().sum::<f64>() / shares.len() as f64,
                     shares.iter().copied().fold(f64::INFINITY, f64::min),
-                    shares.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                    shares.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    if asked.is_empty() {
+                        String::new()
+                    } else {
+                        format!(
+                            " (asked mean {:.3})",
+                            asked.iter().sum::<f64>() / asked.len() as f64
+                        )
+                    }
                 );
             }
         }

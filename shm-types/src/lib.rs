@@ -58,8 +58,9 @@ pub use text::FixedText;
 /// version 4: the simulator's actuator load in [`SimTruth`]; version 5: the count of the legs'
 /// terrain collisions in [`SimTruth`]; version 6: the environment's force on each palm in
 /// [`SimTruth`]; version 7: the planned duration of the dynamic gait's current phase and its
-/// source in [`Telemetry`].
-pub const PROTOCOL_VERSION: u32 = 7;
+/// source in [`Telemetry`]; version 8: the vertical force asked of each held hand in
+/// [`Telemetry`].
+pub const PROTOCOL_VERSION: u32 = 8;
 
 /// Fixed joint capacity of the joint arrays; messages carry the used count explicitly.
 pub const MAX_JOINTS: usize = 64;

@@ -17,7 +17,7 @@ pub const WRENCH_ORDER: [&str; 4] = ["left_foot", "right_foot", "left_hand", "ri
 /// One sensor reading, adapter → daemon.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v7.SensorSample")]
+#[type_name("walk.v8.SensorSample")]
 pub struct SensorSample {
     /// Strictly increasing per adapter run.
     pub seq: u64,
@@ -53,7 +53,7 @@ wire_enum! {
 /// One joint command, daemon → adapter.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v7.JointCommand")]
+#[type_name("walk.v8.JointCommand")]
 pub struct JointCommand {
     /// Strictly increasing per daemon run.
     pub seq: u64,
@@ -196,7 +196,7 @@ wire_enum! {
 /// Percentiles of a latency distribution in microseconds.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("walk.v7.LatencySummary")]
+#[type_name("walk.v8.LatencySummary")]
 pub struct LatencySummary {
     /// Median.
     pub p50: f32,
@@ -213,7 +213,7 @@ pub const HISTOGRAM_BUCKETS: usize = 20;
 /// [2^b, 2^(b+1)) µs, the last bucket everything above.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("walk.v7.LogHistogram")]
+#[type_name("walk.v8.LogHistogram")]
 pub struct LogHistogram {
     /// Samples per bucket.
     pub counts: [u64; HISTOGRAM_BUCKETS],
@@ -229,7 +229,7 @@ impl LogHistogram {
 /// The daemon's state, published at a low rate (daemon → clients) and returned by `control`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v7.DaemonStatus")]
+#[type_name("walk.v8.DaemonStatus")]
 pub struct DaemonStatus {
     /// [`crate::PROTOCOL_VERSION`] of the daemon.
     pub protocol_version: u32,
@@ -384,7 +384,7 @@ pub const FAULT_TEXT: usize = 256;
 /// [`DaemonStatus`] (world frame, translation xyz + quaternion xyzw of the sole frames).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("walk.v7.SimTruth")]
+#[type_name("walk.v8.SimTruth")]
 pub struct SimTruth {
     /// Strictly increasing per simulator run (a gap means a subscriber missed messages).
     pub seq: u64,
@@ -428,7 +428,7 @@ pub struct SimTruth {
 /// group or joints without a limit).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("walk.v7.ActuatorLoad")]
+#[type_name("walk.v8.ActuatorLoad")]
 pub struct ActuatorLoad {
     /// Peak sustained torque as a fraction of the effort limit, per joint group.
     pub peak_torque_fraction: [f64; 4],
@@ -479,7 +479,7 @@ impl Default for SimTruth {
 /// The daemon's answer to a submitted sequence.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v7.SubmitReply")]
+#[type_name("walk.v8.SubmitReply")]
 pub struct SubmitReply {
     /// Whether the sequence was validated, prepared and started.
     pub accepted: Flag,
@@ -530,7 +530,7 @@ wire_enum! {
 /// A control request (client → daemon).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v7.ControlRequest")]
+#[type_name("walk.v8.ControlRequest")]
 pub struct ControlRequest {
     /// The command.
     pub command: Code<ControlCommand>,
@@ -554,7 +554,7 @@ impl Default for ControlRequest {
 /// The daemon's answer to a control request.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
-#[type_name("walk.v7.ControlReply")]
+#[type_name("walk.v8.ControlReply")]
 pub struct ControlReply {
     /// Whether the command was carried out.
     pub accepted: Flag,

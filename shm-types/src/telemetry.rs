@@ -70,7 +70,7 @@ wire_enum! {
 /// What the controller estimated and aimed at in one control tick (walkd → observers).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v7.Telemetry")]
+#[type_name("walk.v8.Telemetry")]
 pub struct Telemetry {
     /// Increases by one with every telemetry published in a daemon run, from 1: a gap means a
     /// subscriber lost messages.
@@ -115,6 +115,10 @@ pub struct Telemetry {
     /// Planned duration of the dynamic gait's current phase (s; 0 where `phase_timing` is
     /// `none`): a client sees the step times a timed sequence set.
     pub phase_duration_s: f64,
+    /// The vertical force (N) asked of each held hand (left, right): what its press tracks, its
+    /// share of the weight in the static gait (never less than the touch); 0 for a hand not in
+    /// the contact set. Beside the palms' measured wrenches it shows the desired split.
+    pub hand_forces_desired: [f64; 2],
     /// Valid vertices in `support`.
     pub support_count: u32,
     /// Index of the stance being moved towards.
@@ -159,6 +163,7 @@ impl Telemetry {
         dcm_reference: [0.0; 2],
         dcm_measured: [0.0; 2],
         phase_duration_s: 0.0,
+        hand_forces_desired: [0.0; 2],
         support_count: 0,
         stance_index: 0,
         stance_count: 0,
@@ -198,14 +203,15 @@ mod tests {
         assert_eq!(telemetry.support().len(), SUPPORT_VERTICES);
     }
 
-    /// The fields protocol v7 added sit next to fields of their size, without padding before or
-    /// after them, so the layout is the same on every target iceoryx2 maps it on.
+    /// The fields protocols v7 and v8 added sit next to fields of their size, without padding
+    /// before or after them, so the layout is the same on every target iceoryx2 maps it on.
     #[test]
-    fn the_phase_timing_fields_add_no_padding() {
+    fn the_phase_timing_and_hand_force_fields_add_no_padding() {
         use std::mem::{offset_of, size_of};
         let after_dcm = offset_of!(Telemetry, dcm_measured) + size_of::<[f64; 2]>();
         assert_eq!(offset_of!(Telemetry, phase_duration_s), after_dcm);
-        assert_eq!(offset_of!(Telemetry, support_count), after_dcm + 8);
+        assert_eq!(offset_of!(Telemetry, hand_forces_desired), after_dcm + 8);
+        assert_eq!(offset_of!(Telemetry, support_count), after_dcm + 24);
         let after_phase = offset_of!(Telemetry, phase) + size_of::<u32>();
         assert_eq!(offset_of!(Telemetry, phase_timing), after_phase);
         assert_eq!(offset_of!(Telemetry, contacts), after_phase + 4);

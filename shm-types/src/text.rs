@@ -6,7 +6,7 @@ use iceoryx2::prelude::ZeroCopySend;
 /// Longer input is cut at a character boundary.
 #[repr(C)]
 #[derive(Clone, Copy, ZeroCopySend)]
-#[type_name("walk.v7.FixedText")]
+#[type_name("walk.v8.FixedText")]
 pub struct FixedText<const N: usize> {
     len: u32,
     bytes: [u8; N],

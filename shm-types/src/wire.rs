@@ -57,7 +57,7 @@ pub struct Code<T> {
 // and valid for every bit pattern.
 unsafe impl<T: WireEnum> ZeroCopySend for Code<T> {
     unsafe fn type_name() -> &'static str {
-        "walk.v7.Code"
+        "walk.v8.Code"
     }
 }
 
@@ -142,7 +142,7 @@ impl<T: WireEnum> From<T> for Code<T> {
 /// A yes/no field as it travels: 0 or 1 in a byte, decoded with a check.
 #[repr(C)]
 #[derive(Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
-#[type_name("walk.v7.Flag")]
+#[type_name("walk.v8.Flag")]
 pub struct Flag(u8);
 
 impl Flag {

@@ -162,15 +162,21 @@ fn jvrc1_walks_under_mujoco_physics_without_falling() {
 
 /// A walk that holds the left hand on a railing, in a MuJoCo world without one (the flat
 /// floor): the hand presses on nothing (it sinks `hand_press_depth_m` at most, docs/controller.md,
-/// "Hands on a railing"); asked for its share of the weight, it is measured to carry none, so the
-/// CoM never leans towards it ("Hands carry weight in the static gait"), and the walk goes on
-/// without it to the end, upright, the simulator reading no force on the palm.
+/// "Hands on a railing"); asked for its share of the weight (walkd's telemetry shows the force
+/// asked: JVRC-1's `hand_support_share` is 0.16), it is measured to carry none, so the CoM never
+/// leans towards it ("Hands carry weight in the static gait"), and the walk goes on without it
+/// to the end, upright, the simulator reading no force on the palm.
 #[test]
 fn a_hand_that_finds_no_railing_leaves_the_walk_to_the_feet() {
     let run = evaluate_walk_with("jvrc1", "feet+left-hand", "mujoco", 0.4);
     assert!(run["max_tilt_rad"].as_f64().unwrap() < 0.1, "{run}");
     let share = run["hand_support_share"].as_f64().expect("a held hand");
     assert!(share.abs() < 1e-9, "the palm touched something: {run}");
+    let asked = run["hand_support_asked"].as_f64().expect("a hand held");
+    assert!(
+        asked > 0.1,
+        "walkd asked the hand for {asked} of the weight: {run}"
+    );
 }
 
 #[test]

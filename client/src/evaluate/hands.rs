@@ -4,6 +4,7 @@
 use kinematics::robot::EndEffector;
 use shm_types::SimTruth;
 
+use super::telemetry::AskedForce;
 use super::truth::state_at;
 
 /// The mean vertical force of the environment on both palms, divided by the robot's weight
@@ -31,6 +32,25 @@ pub(crate) fn support_share(
         count += 1;
     }
     (count > 0).then(|| sum / count as f64 / weight_n)
+}
+
+/// The mean vertical force walkd asked of the held hands (`asked`, per stance index, from its
+/// telemetry), divided by the robot's weight (`weight_n`), over the stances in which a hand is
+/// planned in contact ([`hand_planned_held`], as [`support_share`] counts): the desired split
+/// beside the measured one. `None` when walkd held no hand in those stances.
+pub(crate) fn asked_share(
+    contacts: &[[bool; 4]],
+    asked: &[AskedForce],
+    weight_n: f64,
+) -> Option<f64> {
+    let (sum, ticks) = asked
+        .iter()
+        .enumerate()
+        .filter(|(index, _)| hand_planned_held(contacts, *index))
+        .fold((0.0, 0), |(sum, ticks), (_, a)| {
+            (sum + a.sum_n, ticks + a.ticks)
+        });
+    (ticks > 0).then(|| sum / ticks as f64 / weight_n)
 }
 
 /// Whether a hand is planned to carry while the walk moves towards stance `index` of `contacts`
@@ -127,6 +147,23 @@ mod tests {
         let statuses = [(1, 1000), (2, 2000), (2, 3000), (3, 4000)];
         let share = support_share(&contacts, statuses, &states, 1000.0).unwrap();
         assert!((share - 0.25).abs() < 1e-12, "{share}");
+    }
+
+    #[test]
+    fn the_asked_share_averages_the_force_asked_over_the_planned_held_stances() {
+        let (feet, right) = ([true, true, false, false], [true, true, false, true]);
+        // Stance 1 reaches for the rail (not yet meant to carry), stances 2 and 3 hold it.
+        let contacts = [feet, right, right, right, feet];
+        let asked = |sum_n, ticks| AskedForce { sum_n, ticks };
+        let per_stance = [
+            asked(0.0, 0),
+            asked(50.0, 5),
+            asked(300.0, 2),
+            asked(500.0, 2),
+        ];
+        let share = asked_share(&contacts, &per_stance, 100.0).unwrap();
+        assert!((share - 2.0).abs() < 1e-12, "{share}");
+        assert_eq!(asked_share(&contacts, &per_stance[..2], 100.0), None);
     }
 
     #[test]

@@ -2,8 +2,9 @@
 //! (`<prefix>/telemetry`, read by the observer's [`Source`]), on a thread of its own: every
 //! [`KEEP_EVERY`]th tick that carries ZMP and DCM, for the balance row of Fig. 6, every tick
 //! at which the daemon's state changed (to time a controlled stop to the tick), every planned
-//! support phase the dynamic gait entered ([`super::timing`]), and the stances in which each hand
-//! was in the controller's contact set ([`super::hands::reaches_given_up`]).
+//! support phase the dynamic gait entered ([`super::timing`]), the stances in which each hand
+//! was in the controller's contact set ([`super::hands::reaches_given_up`]) and the force asked
+//! of the held hands there ([`super::hands::asked_share`]).
 
 use std::sync::mpsc::Receiver;
 use std::thread::JoinHandle;
@@ -42,6 +43,17 @@ struct Kept {
     changes: Vec<StateChange>,
     phases: Vec<PlannedPhase>,
     hands_held: Vec<[bool; 2]>,
+    hands_asked: Vec<AskedForce>,
+}
+
+/// The vertical force asked of the held hands over the ticks of one stance index at which walkd
+/// held a hand (`Telemetry::hand_forces_desired`, both hands summed).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct AskedForce {
+    /// The sum over those ticks (N).
+    pub sum_n: f64,
+    /// How many ticks.
+    pub ticks: u64,
 }
 
 /// What a walk's telemetry showed, from the tick it started.
@@ -55,6 +67,8 @@ pub(crate) struct RecordedTelemetry {
     /// By stance index (the stance walkd moved towards): whether the left and the right hand
     /// were in its contact set at any tick.
     pub hands_held: Vec<[bool; 2]>,
+    /// By stance index: the force asked of the held hands while walkd held one.
+    pub hands_asked: Vec<AskedForce>,
 }
 
 /// The ticks and ZMP/DCM of a walk's telemetry, until [`TelemetryRecorder::finish`].
@@ -104,6 +118,7 @@ impl TelemetryRecorder {
             state_changes: changes,
             phases: kept.phases,
             hands_held: kept.hands_held,
+            hands_asked: kept.hands_asked,
         })
     }
 }
@@ -133,10 +148,14 @@ fn collect(batches: &Receiver<Batch>) -> Kept {
             if hands.contains(&true) && stance < MAX_STANCES {
                 if kept.hands_held.len() <= stance {
                     kept.hands_held.resize(stance + 1, [false; 2]);
+                    kept.hands_asked.resize(stance + 1, AskedForce::default());
                 }
                 for (held, now) in kept.hands_held[stance].iter_mut().zip(hands) {
                     *held |= now;
                 }
+                let asked = &mut kept.hands_asked[stance];
+                asked.sum_n += telemetry.hand_forces_desired.iter().sum::<f64>();
+                asked.ticks += 1;
             }
             if telemetry.dynamics_valid.is_set() && telemetry.tick % KEEP_EVERY == 0 {
                 kept.balance.push(telemetry);
@@ -151,11 +170,15 @@ mod tests {
     use super::*;
     use shm_types::Flag;
 
+    /// A telemetry towards `stance_index` with the hands held as given, each held hand asked
+    /// for 10 N.
     fn telemetry(stance_index: u32, left_hand: bool, right_hand: bool) -> Telemetry {
         let mut telemetry = Telemetry::ZERO;
         telemetry.stance_index = stance_index;
         telemetry.contacts[EndEffector::LeftHand as usize] = Flag::from(left_hand);
         telemetry.contacts[EndEffector::RightHand as usize] = Flag::from(right_hand);
+        telemetry.hand_forces_desired =
+            [left_hand, right_hand].map(|held| 10.0 * f64::from(u8::from(held)));
         telemetry
     }
 
@@ -184,6 +207,12 @@ mod tests {
         assert_eq!(
             kept.hands_held,
             [[false; 2], [false; 2], [false, true], [true, false]]
+        );
+        // The force asked, over the ticks that held a hand only.
+        let asked = |sum_n, ticks| AskedForce { sum_n, ticks };
+        assert_eq!(
+            kept.hands_asked,
+            [asked(0.0, 0), asked(0.0, 0), asked(10.0, 1), asked(10.0, 1)]
         );
     }
 }

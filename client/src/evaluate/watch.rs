@@ -12,7 +12,7 @@ use nalgebra::Isometry3;
 use shm_types::{DaemonStatus, SimTruth};
 use stance::PostProcessedSequence;
 
-use super::telemetry::{StateChange, TelemetryRecorder};
+use super::telemetry::{AskedForce, StateChange, TelemetryRecorder};
 use super::timing::PlannedPhase;
 use super::truth::{TruthRecorder, Verdict, state_at};
 use super::{BalanceSample, Points, TraceSample, align_targets};
@@ -75,6 +75,9 @@ pub(crate) struct WatchedWalk {
     /// Per stance index, whether each hand was in walkd's contact set, with
     /// [`WatchOptions::telemetry`] (`None` without).
     pub hands_held: Option<Vec<[bool; 2]>>,
+    /// Per stance index, the force asked of the held hands while walkd held one, with
+    /// [`WatchOptions::telemetry`] (empty without).
+    pub(crate) hands_asked: Vec<AskedForce>,
     /// The recording, with [`WatchOptions::record`].
     pub recording: Option<RecorderOutcome>,
 }
@@ -125,7 +128,7 @@ pub(crate) fn watch_walk(
     std::thread::sleep(options.linger);
     let recording = observer.map(Recorder::finish).transpose()?;
     let states = recorder.finish()?;
-    let (balance, state_changes, phases, hands_held) = match telemetry {
+    let (balance, state_changes, phases, hands_held, hands_asked) = match telemetry {
         Some(recorder) => {
             let recorded = recorder.finish(start.ticks, start.rate_hz)?;
             (
@@ -133,6 +136,7 @@ pub(crate) fn watch_walk(
                 recorded.state_changes,
                 recorded.phases,
                 Some(recorded.hands_held),
+                recorded.hands_asked,
             )
         }
         None => Default::default(),
@@ -164,6 +168,7 @@ pub(crate) fn watch_walk(
         state_changes,
         phases,
         hands_held,
+        hands_asked,
         recording,
     })
 }

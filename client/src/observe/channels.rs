@@ -397,6 +397,7 @@ fn tick_message(telemetry: &Telemetry, stamp: Timestamp) -> WalkTick {
         dcm_measured: planar(&telemetry.dcm_measured),
         phase_duration_s: telemetry.phase_duration_s,
         phase_timing: telemetry.phase_timing.name().to_owned(),
+        hand_forces_desired: telemetry.hand_forces_desired.to_vec(),
         compute_us: telemetry.compute_ns as f64 / 1e3,
         latency_us: if commanded {
             telemetry

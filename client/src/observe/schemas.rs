@@ -50,6 +50,9 @@ pub struct WalkTick {
     /// Where that duration came from: `sequence`, `clamped` (the sequence's, moved into the
     /// config's limits), `config`, or `none`.
     pub phase_timing: String,
+    /// The vertical force (N) asked of each held hand, left and right (0: not held): the desired
+    /// split beside the palms' measured wrenches on `/wrenches`.
+    pub hand_forces_desired: Vec<f64>,
     /// Controller compute time (µs).
     pub compute_us: f64,
     /// Sample time stamp → command sent (µs; 0 without a command).

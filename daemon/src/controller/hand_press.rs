@@ -23,7 +23,6 @@ use kinematics::robot::EndEffector;
 use nalgebra::Vector3;
 
 use super::config::ControllerConfig;
-use super::hand_support::hand_slot;
 use super::machine::Targets;
 
 /// The held hands' target offsets (m, world; see the module docs).
@@ -45,13 +44,16 @@ impl HandPress {
     ) {
         for (offset, hand) in self.offsets.iter_mut().zip(EndEffector::HANDS) {
             let h = hand as usize;
+            let wanted = Vector3::new(
+                0.0,
+                0.0,
+                targets.hand_force_pressed(hand, config.hand_force_n),
+            );
             let (true, Some(task)) = (targets.contacts[h], targets.end_effectors[h].as_mut())
             else {
                 *offset = Vector3::zeros();
                 continue;
             };
-            let asked = targets.hand_forces[hand_slot(hand)];
-            let wanted = Vector3::new(0.0, 0.0, asked.max(config.hand_force_n));
             let force = Vector3::new(wrenches[h][0], wrenches[h][1], wrenches[h][2]);
             let speed = config.hand_press_speed;
             let step = (config.hand_admittance * (force - wanted)).map(|v| v.clamp(-speed, speed));

@@ -13,7 +13,7 @@ use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
 
 use super::config::ControllerConfig;
 use super::gait::{distribute, force_difference_velocities};
-use super::hand_support::{HandLoad, HandSupport};
+use super::hand_support::{HandLoad, HandSupport, hand_slot};
 use super::plan::{Step, TransitionPlan};
 use super::sequence::PreparedSequence;
 use super::status::{FaultCode, Phase};
@@ -92,6 +92,16 @@ impl Targets {
             torso_posture_weight: None,
             hand_forces: [0.0; 2],
             hand_load: HandLoad::NONE,
+        }
+    }
+
+    /// The vertical force (N) the press of `hand` tracks (`hand_press`): the force asked of it,
+    /// never less than the touch `touch_n`, while it is held; 0 for a hand not held.
+    pub fn hand_force_pressed(&self, hand: EndEffector, touch_n: f64) -> f64 {
+        if self.contacts[hand as usize] {
+            self.hand_forces[hand_slot(hand)].max(touch_n)
+        } else {
+            0.0
         }
     }
 
@@ -1068,6 +1078,19 @@ mod tests {
             rise: -0.1,
         };
         assert!((down.height(2.0, 2.0).height - 0.75).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_held_hand_presses_with_its_share_never_less_than_the_touch() {
+        let mut targets = Targets::none();
+        targets.hand_forces = [0.0, 95.0];
+        let pressed = |targets: &Targets| {
+            EndEffector::HANDS.map(|hand| targets.hand_force_pressed(hand, 10.0))
+        };
+        assert_eq!(pressed(&targets), [0.0, 0.0], "no hand held");
+        targets.contacts[EndEffector::LeftHand as usize] = true;
+        targets.contacts[EndEffector::RightHand as usize] = true;
+        assert_eq!(pressed(&targets), [10.0, 95.0]);
     }
 
     #[test]

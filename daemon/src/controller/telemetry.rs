@@ -31,6 +31,9 @@ pub struct ControllerTelemetry {
     /// Support polygon of the feet in contact, as the CoM constraint uses it: moved towards the
     /// held hands by the weight they carry.
     pub support: SupportPolygon,
+    /// The vertical force (N) each held hand's press tracks (left, right; 0 for a hand not
+    /// held): the desired split of the weight between the hands and the feet.
+    pub hand_forces_desired: [f64; 2],
 }
 
 impl Controller {
@@ -62,6 +65,8 @@ impl Controller {
                 [com.x, com.y]
             }),
             support: self.support_polygon(targets),
+            hand_forces_desired: EndEffector::HANDS
+                .map(|hand| targets.hand_force_pressed(hand, self.config.hand_force_n)),
         }
     }
 

@@ -45,6 +45,7 @@ pub(super) fn fill(out: &mut Telemetry, state: DaemonState, controller: &Control
     let (duration_s, timing) = planned_phase(status, dynamic);
     out.phase_duration_s = duration_s;
     out.phase_timing = Code::new(timing);
+    out.hand_forces_desired = controller.hand_forces_desired;
 }
 
 /// The planned duration of the footstep-plan phase under way and its source; none outside one
