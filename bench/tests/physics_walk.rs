@@ -71,7 +71,7 @@ mod walks {
             affordances.name(),
             report.outcome.label()
         );
-        write_fig6(&plot, &title, &report.trace, &[]).expect("writing Fig. 6");
+        write_fig6(&plot, &title, &report.trace, &[], &[]).expect("writing Fig. 6");
         print_report(
             &format!("{robot} {}", affordances.name()),
             distance,

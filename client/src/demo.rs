@@ -333,7 +333,13 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
                 args.physics.name(),
                 gait.name()
             );
-            crate::evaluate::write_fig6(&file, &title, &walk.trace, &walk.balance)?;
+            crate::evaluate::write_fig6(
+                &file,
+                &title,
+                &walk.trace,
+                &walk.balance,
+                &walk.hand_forces,
+            )?;
             Some(file)
         }
         None => None,

@@ -36,7 +36,7 @@ pub(crate) mod truth;
 pub(crate) mod watch;
 
 use actuators::ActuatorReport;
-pub use fig6::{BalanceSample, write_fig6};
+pub use fig6::{BalanceSample, HandSample, write_fig6};
 use footholds::{PlannedFootholds, StepReport};
 pub use record::{GroupSummary, MatrixCells, WalkRecord, group_by_cell, speed_cell};
 
@@ -258,6 +258,8 @@ pub struct RunResult {
     pub trace: Vec<TraceSample>,
     /// A dynamic walk's ZMP and DCM from walkd's telemetry (empty for the static gait).
     pub balance: Vec<BalanceSample>,
+    /// The hands' vertical forces, asked by walkd and measured at the wrists, for Fig. 6.
+    pub hand_forces: Vec<HandSample>,
     /// With an injected fault: how the walk stopped (it decides `record.success`).
     pub stop: Option<StopReport>,
     /// Steps, footholds, elevations and terrain collisions from the simulator's truth.
@@ -508,7 +510,13 @@ fn plot_robot(dir: &Path, robot: &str, results: &[RunResult]) -> anyhow::Result<
         result.record.seed,
         result.record.outcome
     );
-    write_fig6(&file, &title, &result.trace, &result.balance)
+    write_fig6(
+        &file,
+        &title,
+        &result.trace,
+        &result.balance,
+        &result.hand_forces,
+    )
 }
 
 /// Run number `slot` of a robot, its walk from `source`: own processes on an own prefix, submit,
@@ -708,6 +716,7 @@ fn run_once(
         gait,
         trace: walk.trace,
         balance: walk.balance,
+        hand_forces: walk.hand_forces,
         stop,
         steps,
         hand_support_share,

@@ -1,7 +1,8 @@
 //! The paper's Fig. 6 for one walk: x, y and z over time of the CoM and both soles — target
 //! (dashed), controller estimate (solid) and, where known, the simulator's truth (dotted). A
 //! dynamic walk adds a row for its balance: the walking pattern's ZMP and DCM against the
-//! measured ones, x and y.
+//! measured ones, x and y. A walk that holds a hand adds a row for each hand's vertical force:
+//! asked by walkd against measured at the wrist.
 
 use std::path::Path;
 
@@ -26,14 +27,28 @@ pub struct BalanceSample {
     pub dcm_measured: [f64; 2],
 }
 
-/// Writes Fig. 6 of `trace` (and the balance row of `balance`, when it has samples) as SVG.
+/// The vertical force on both hands at one instant (left, right; N): what walkd asked of them
+/// (`Telemetry::hand_forces_desired`) and what their wrists measured (the answered sample).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HandSample {
+    /// Time since the walk started (s).
+    pub t: f64,
+    /// Asked of each held hand (0: not held).
+    pub asked: [f64; 2],
+    /// The environment's vertical force on each palm, at its wrist.
+    pub measured: [f64; 2],
+}
+
+/// Writes Fig. 6 of `trace` as SVG, with the balance row of `balance` and the hands row of
+/// `hands` when they have samples (the hands row only when a hand was asked for a force).
 pub fn write_fig6(
     file: &Path,
     title: &str,
     trace: &[TraceSample],
     balance: &[BalanceSample],
+    hands: &[HandSample],
 ) -> anyhow::Result<()> {
-    draw(file, title, trace, balance)
+    draw(file, title, trace, balance, hands)
         .map_err(|e| anyhow::anyhow!("{}: cannot draw Fig. 6: {e}", file.display()))
 }
 
@@ -82,9 +97,18 @@ const ZMP_REFERENCE: Style = Style::dashed("ZMP reference", RED);
 const ZMP_MEASURED: Style = Style::solid("ZMP measured", BLUE);
 const DCM_REFERENCE: Style = Style::dashed("DCM reference", RGBColor(230, 140, 0));
 const DCM_MEASURED: Style = Style::solid("DCM measured", MAGENTA);
+const FORCE_ASKED: Style = Style::dashed("asked", RED);
+const FORCE_MEASURED: Style = Style::solid("measured", BLUE);
 
-fn draw(file: &Path, title: &str, trace: &[TraceSample], balance: &[BalanceSample]) -> DrawResult {
-    let rows = if balance.is_empty() { 3 } else { 4 };
+fn draw(
+    file: &Path,
+    title: &str,
+    trace: &[TraceSample],
+    balance: &[BalanceSample],
+    hands: &[HandSample],
+) -> DrawResult {
+    let hands_held = hands.iter().any(|s| s.asked.iter().any(|f| *f > 0.0));
+    let rows = 3 + usize::from(!balance.is_empty()) + usize::from(hands_held);
     let root = SVGBackend::new(file, (1500, 300 * rows as u32)).into_drawing_area();
     root.fill(&WHITE)?;
     let root = root.titled(title, ("sans-serif", 20))?;
@@ -112,10 +136,10 @@ fn draw(file: &Path, title: &str, trace: &[TraceSample], balance: &[BalanceSampl
             ]
             .map(|(style, points)| Line { points, style });
             let caption = format!("{name} {}", ["x", "y", "z"][axis]);
-            panel(area, &caption, end, &lines, r == 0 && axis == 0)?;
+            panel(area, &caption, end, &lines, r == 0 && axis == 0, "m")?;
         }
     }
-    if let Some(row_area) = row_areas.get(3) {
+    if let Some(row_area) = row_areas.get(3).filter(|_| !balance.is_empty()) {
         for (axis, area) in row_area.split_evenly((1, 2)).iter().enumerate() {
             let line = |get: fn(&BalanceSample) -> [f64; 2]| -> Vec<(f64, f64)> {
                 balance
@@ -132,15 +156,36 @@ fn draw(file: &Path, title: &str, trace: &[TraceSample], balance: &[BalanceSampl
             ]
             .map(|(style, points)| Line { points, style });
             let caption = format!("ZMP and DCM {}", ["x", "y"][axis]);
-            panel(area, &caption, end, &lines, axis == 0)?;
+            panel(area, &caption, end, &lines, axis == 0, "m")?;
+        }
+    }
+    if let Some(row_area) = row_areas.last().filter(|_| hands_held) {
+        for (k, area) in row_area.split_evenly((1, 2)).iter().enumerate() {
+            let line = |get: fn(&HandSample) -> [f64; 2]| -> Vec<(f64, f64)> {
+                hands.iter().map(|s| (s.t, get(s)[k])).collect()
+            };
+            let lines = [
+                (FORCE_ASKED, line(|s| s.asked)),
+                (FORCE_MEASURED, line(|s| s.measured)),
+            ]
+            .map(|(style, points)| Line { points, style });
+            let caption = format!("{} hand vertical force", ["left", "right"][k]);
+            panel(area, &caption, end, &lines, k == 0, "N")?;
         }
     }
     root.present()?;
     Ok(())
 }
 
-/// One panel of `lines` over `0..end` s, with the legend if `legend`.
-fn panel(area: &Area, caption: &str, end: f64, lines: &[Line], legend: bool) -> DrawResult {
+/// One panel of `lines` over `0..end` s, values in `unit`, with the legend if `legend`.
+fn panel(
+    area: &Area,
+    caption: &str,
+    end: f64,
+    lines: &[Line],
+    legend: bool,
+    unit: &str,
+) -> DrawResult {
     let (lo, hi) = lines
         .iter()
         .flat_map(|line| line.points.iter().map(|(_, v)| *v))
@@ -158,7 +203,7 @@ fn panel(area: &Area, caption: &str, end: f64, lines: &[Line], legend: bool) -> 
     chart
         .configure_mesh()
         .x_desc("t (s)")
-        .y_desc("m")
+        .y_desc(unit)
         .light_line_style(WHITE)
         .draw()?;
     for line in lines.iter().filter(|line| !line.points.is_empty()) {
@@ -181,4 +226,56 @@ fn panel(area: &Area, caption: &str, end: f64, lines: &[Line], legend: bool) -> 
             .draw()?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn trace() -> Vec<TraceSample> {
+        let points = Points {
+            com: Vector3::new(0.0, 0.0, 0.8),
+            left_foot: Vector3::new(0.0, 0.1, 0.0),
+            right_foot: Vector3::new(0.0, -0.1, 0.0),
+        };
+        (0..3)
+            .map(|i| TraceSample {
+                t: f64::from(i),
+                stance_index: 0,
+                target: points,
+                controller: points,
+                sim: None,
+            })
+            .collect()
+    }
+
+    /// The SVG of a walk whose right hand was asked for `asked` N.
+    fn drawn(asked: f64) -> String {
+        let hands: Vec<HandSample> = (0..3)
+            .map(|i| HandSample {
+                t: f64::from(i),
+                asked: [0.0, asked],
+                measured: [0.0, 0.9 * asked],
+            })
+            .collect();
+        let file = std::env::temp_dir().join(format!("fig6-{}-{asked}.svg", std::process::id()));
+        write_fig6(&file, "walk", &trace(), &[], &hands).unwrap();
+        let svg = std::fs::read_to_string(&file).unwrap();
+        std::fs::remove_file(&file).unwrap();
+        svg
+    }
+
+    #[test]
+    fn a_walk_that_asks_a_hand_for_a_force_gets_a_row_of_hand_forces() {
+        let svg = drawn(95.0);
+        assert!(svg.contains("right hand vertical force"), "no hands row");
+        assert!(
+            svg.contains("\nasked\n") && svg.contains("\nmeasured\n"),
+            "no legend"
+        );
+        assert!(
+            !drawn(0.0).contains("hand vertical force"),
+            "a row for hands never held"
+        );
+    }
 }

@@ -3,8 +3,9 @@
 //! [`KEEP_EVERY`]th tick that carries ZMP and DCM, for the balance row of Fig. 6, every tick
 //! at which the daemon's state changed (to time a controlled stop to the tick), every planned
 //! support phase the dynamic gait entered ([`super::timing`]), the stances in which each hand
-//! was in the controller's contact set ([`super::hands::reaches_given_up`]) and the force asked
-//! of the held hands there ([`super::hands::asked_share`]).
+//! was in the controller's contact set ([`super::hands::reaches_given_up`]), the force asked
+//! of the held hands there ([`super::hands::asked_share`]), and every [`KEEP_EVERY`]th tick's
+//! hand forces, asked and measured, for the hands row of Fig. 6.
 
 use std::sync::mpsc::Receiver;
 use std::thread::JoinHandle;
@@ -13,7 +14,7 @@ use anyhow::Context;
 use kinematics::robot::EndEffector;
 use shm_types::{DaemonState, Telemetry};
 
-use super::fig6::BalanceSample;
+use super::fig6::{BalanceSample, HandSample};
 use super::timing::PlannedPhase;
 use crate::observe::source::{Batch, Source};
 
@@ -44,6 +45,8 @@ struct Kept {
     phases: Vec<PlannedPhase>,
     hands_held: Vec<[bool; 2]>,
     hands_asked: Vec<AskedForce>,
+    /// Tick, forces asked and measured (left, right hand; N).
+    hand_forces: Vec<(u64, [f64; 2], [f64; 2])>,
 }
 
 /// The vertical force asked of the held hands over the ticks of one stance index at which walkd
@@ -69,6 +72,8 @@ pub(crate) struct RecordedTelemetry {
     pub hands_held: Vec<[bool; 2]>,
     /// By stance index: the force asked of the held hands while walkd held one.
     pub hands_asked: Vec<AskedForce>,
+    /// The hands' vertical forces, asked and measured, for Fig. 6.
+    pub hand_forces: Vec<HandSample>,
 }
 
 /// The ticks and ZMP/DCM of a walk's telemetry, until [`TelemetryRecorder::finish`].
@@ -113,23 +118,49 @@ impl TelemetryRecorder {
             .into_iter()
             .filter(|c| c.tick >= start_tick)
             .collect();
+        let hand_forces = kept
+            .hand_forces
+            .iter()
+            .filter(|(tick, ..)| *tick >= start_tick)
+            .map(|&(tick, asked, measured)| HandSample {
+                t: (tick - start_tick) as f64 / rate_hz,
+                asked,
+                measured,
+            })
+            .collect();
         Ok(RecordedTelemetry {
             samples: balance,
             state_changes: changes,
             phases: kept.phases,
             hands_held: kept.hands_held,
             hands_asked: kept.hands_asked,
+            hand_forces,
         })
     }
 }
 
 /// Keeps every [`KEEP_EVERY`]th telemetry with ZMP and DCM, every state change, every new
-/// planned phase and the hands in contact per stance, until the batches end.
+/// planned phase, the hands in contact per stance and every [`KEEP_EVERY`]th tick's hand forces
+/// (measured: the answered sample's palm wrenches, when it came in the same batch, else the
+/// latest), until the batches end.
 fn collect(batches: &Receiver<Batch>) -> Kept {
     let mut kept = Kept::default();
     let mut state = None;
+    let mut measured = [0.0; 2];
     for batch in batches {
+        let palms = |sample: &shm_types::SensorSample| {
+            EndEffector::HANDS.map(|hand| sample.wrenches[hand as usize][2])
+        };
         for telemetry in batch.telemetry {
+            if let Some(sample) = batch.samples.iter().find(|s| s.seq == telemetry.sample_seq) {
+                measured = palms(sample);
+            } else if let Some(sample) = batch.samples.last() {
+                measured = palms(sample);
+            }
+            if telemetry.tick % KEEP_EVERY == 0 {
+                kept.hand_forces
+                    .push((telemetry.tick, telemetry.hand_forces_desired, measured));
+            }
             let now = telemetry.state.get().ok();
             if now.is_some() && now != state {
                 state = now;
@@ -208,11 +239,41 @@ mod tests {
             kept.hands_held,
             [[false; 2], [false; 2], [false, true], [true, false]]
         );
+        // Every tick of the helper is tick 0, so each is kept for Fig. 6 (none measured).
+        assert_eq!(kept.hand_forces.len(), 5);
+        assert_eq!(kept.hand_forces[1], (0, [0.0, 10.0], [0.0; 2]));
         // The force asked, over the ticks that held a hand only.
         let asked = |sum_n, ticks| AskedForce { sum_n, ticks };
         assert_eq!(
             kept.hands_asked,
             [asked(0.0, 0), asked(0.0, 0), asked(10.0, 1), asked(10.0, 1)]
+        );
+    }
+
+    #[test]
+    fn every_fifth_tick_keeps_the_hand_forces_asked_and_measured_by_its_sample() {
+        let (send, receive) = std::sync::mpsc::channel();
+        let mut sample = shm_types::SensorSample::ZERO;
+        sample.seq = 7;
+        sample.wrenches[EndEffector::RightHand as usize][2] = 42.0;
+        let at = |tick, sample_seq| {
+            let mut telemetry = telemetry(1, false, true);
+            telemetry.tick = tick;
+            telemetry.sample_seq = sample_seq;
+            telemetry
+        };
+        send.send(Batch {
+            telemetry: vec![at(5, 7), at(6, 7)],
+            samples: vec![sample],
+            commands: Vec::new(),
+            statuses: Vec::new(),
+            refused: Vec::new(),
+        })
+        .unwrap();
+        drop(send);
+        assert_eq!(
+            collect(&receive).hand_forces,
+            [(5, [0.0, 10.0], [0.0, 42.0])]
         );
     }
 }

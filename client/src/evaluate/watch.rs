@@ -15,7 +15,7 @@ use stance::PostProcessedSequence;
 use super::telemetry::{AskedForce, StateChange, TelemetryRecorder};
 use super::timing::PlannedPhase;
 use super::truth::{TruthRecorder, Verdict, state_at};
-use super::{BalanceSample, Points, TraceSample, align_targets};
+use super::{BalanceSample, HandSample, Points, TraceSample, align_targets};
 use crate::daemon_client::DaemonClient;
 use crate::observe::channels::isometry;
 use crate::observe::{Recorder, RecorderOutcome};
@@ -68,6 +68,8 @@ pub(crate) struct WatchedWalk {
     pub drift: Option<(f64, usize)>,
     /// The ZMP and DCM telemetry, with [`WatchOptions::telemetry`].
     pub balance: Vec<BalanceSample>,
+    /// The hands' vertical forces, asked and measured, with [`WatchOptions::telemetry`].
+    pub hand_forces: Vec<HandSample>,
     /// The ticks at which the daemon's state changed, with [`WatchOptions::telemetry`].
     pub state_changes: Vec<StateChange>,
     /// The dynamic gait's planned support phases, with [`WatchOptions::telemetry`].
@@ -128,7 +130,7 @@ pub(crate) fn watch_walk(
     std::thread::sleep(options.linger);
     let recording = observer.map(Recorder::finish).transpose()?;
     let states = recorder.finish()?;
-    let (balance, state_changes, phases, hands_held, hands_asked) = match telemetry {
+    let (balance, state_changes, phases, hands_held, hands_asked, hand_forces) = match telemetry {
         Some(recorder) => {
             let recorded = recorder.finish(start.ticks, start.rate_hz)?;
             (
@@ -137,6 +139,7 @@ pub(crate) fn watch_walk(
                 recorded.phases,
                 Some(recorded.hands_held),
                 recorded.hands_asked,
+                recorded.hand_forces,
             )
         }
         None => Default::default(),
@@ -165,6 +168,7 @@ pub(crate) fn watch_walk(
         status_times,
         drift,
         balance,
+        hand_forces,
         state_changes,
         phases,
         hands_held,
