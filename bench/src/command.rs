@@ -65,7 +65,8 @@ pub struct BenchArgs {
     /// URDF overriding the config's (required for HRP-4).
     #[arg(long, value_name = "PATH")]
     pub urdf: Option<PathBuf>,
-    /// Distance to walk (m, 0.01-1000), requested from the generator as distance / scf.
+    /// Distance to walk (m, 0.01-1000), requested from the generator as distance / scf; through
+    /// a `--scene`, its path's first D m (default the whole path).
     #[arg(
         long,
         value_name = "D",
@@ -86,10 +87,10 @@ pub struct BenchArgs {
     pub postprocess: bool,
     #[command(flatten)]
     pub source: SourceArgs,
-    /// Walk through this scene (docs/scenes.md) from its start to its goal: the distance is the
-    /// path's length, and the kinematic simulator stands the feet on its surfaces (its railings
-    /// are not modelled).
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["distance", "sequence"])]
+    /// Walk through this scene (docs/scenes.md) from its start towards its goal (the whole path,
+    /// or its first `--distance` metres), and the kinematic simulator stands the feet on its
+    /// surfaces (its railings are not modelled).
+    #[arg(long, value_name = "FILE", conflicts_with = "sequence")]
     pub scene: Option<PathBuf>,
     /// Support affordances: feet, feet+left-hand or feet+right-hand.
     #[arg(long, value_name = "SET", default_value = "feet")]
@@ -221,7 +222,7 @@ fn bench_sequence(
         let scene = Scene::from_path(path)?;
         let source = args.source.load()?;
         let request = WalkRequest {
-            distance: scene.path_length(),
+            distance: scene.walk_length(args.distance).context("--distance")?,
             affordances: args.affordances,
             seed: args.seed,
             speed: None,

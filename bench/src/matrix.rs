@@ -82,8 +82,8 @@ pub struct MatrixArgs {
     /// How long the push acts (s, 0.001-5).
     #[arg(long, default_value_t = 0.1, value_parser = Range::new(0.001, 5.0).parser())]
     pub push_duration: f64,
-    /// Walk every run through this scene (docs/scenes.md), from its start to its goal, instead
-    /// of on the flat floor; the path's length replaces `--distances`.
+    /// Walk every run through this scene (docs/scenes.md), from its start towards its goal,
+    /// instead of on the flat floor: the whole path, or its first `--distances` metres.
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
     /// Walks run at once (each in its own thread), 1-64.
@@ -242,14 +242,7 @@ pub fn walk_matrix(
         .and_then(toml::Value::as_str)
         .unwrap_or("robot")
         .to_owned();
-    let requests = match &options.scene {
-        Some(scene) => MatrixCells {
-            distances: vec![scene.path_length()],
-            ..args.cells.clone()
-        }
-        .requests()?,
-        None => args.cells.requests()?,
-    };
+    let requests = args.cells.requests(options.scene.as_deref())?;
     let runs = run_all(config, args, &options, &requests);
     let groups = groups(&runs);
     Ok(MatrixReport {

@@ -167,7 +167,10 @@ fn daemon_and_client_flags() -> Vec<Flag> {
     ] {
         flags.push(Flag::new("walkctl evaluate", flag, range, |arg| {
             let args = parse::<client::evaluate::EvaluateArgs>(&["evaluate", arg])?;
-            args.cells.requests().map(drop).map_err(|e| e.to_string())
+            args.cells
+                .requests(None)
+                .map(drop)
+                .map_err(|e| e.to_string())
         }));
     }
     let m = "m.json".to_owned();
@@ -254,7 +257,10 @@ fn bench_flags() -> Vec<Flag> {
             let args = MatrixArgs::try_parse_from(["physics-matrix", "--robot", &cfg, arg])
                 .map_err(|e| e.to_string())?;
             walk_options(&args, stance::Gait::Static).map_err(|e| format!("{e:#}"))?;
-            args.cells.requests().map(drop).map_err(|e| e.to_string())
+            args.cells
+                .requests(None)
+                .map(drop)
+                .map_err(|e| e.to_string())
         }));
     }
     flags

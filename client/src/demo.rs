@@ -26,6 +26,9 @@ use crate::pace::walking_speed;
 use crate::process::{Launch, PlantArgs, Processes, executable_dir};
 use crate::watch::StanceProgress;
 
+/// How far the demo walks on the flat floor when `--distance` is not given (m).
+const DEFAULT_DISTANCE_M: f64 = 1.0;
+
 /// The robots with a vendored config.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum DemoRobot {
@@ -53,9 +56,10 @@ pub struct DemoArgs {
     /// Robot to walk.
     #[arg(long, value_enum, default_value = "armar4")]
     pub robot: DemoRobot,
-    /// Distance to walk forward (m), 0.01-1000.
-    #[arg(long, default_value_t = 1.0, value_parser = DISTANCE_M.parser())]
-    pub distance: f64,
+    /// Distance to walk forward (m, 0.01-1000; default 1). Through a `--scene`: its path's
+    /// first D m, at most its length (default the whole path).
+    #[arg(long, value_parser = DISTANCE_M.parser())]
+    pub distance: Option<f64>,
     /// Simulator of the started `walk-sim`: kinematic or mujoco.
     #[arg(long, default_value = "kinematic")]
     pub physics: Physics,
@@ -98,8 +102,8 @@ pub struct DemoArgs {
     /// `DIR/fig6-<robot>.svg`.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
-    /// Walk through this scene (docs/scenes.md) from its start to its goal instead of
-    /// `--distance` on the flat floor; needs `--physics mujoco`.
+    /// Walk through this scene (docs/scenes.md) from its start towards its goal instead of on
+    /// the flat floor.
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
 }
@@ -260,20 +264,16 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
     let scene = load_scene(args.scene.as_deref())?;
     let source = args.source.load()?;
     let params = stance::PostProcessParams::from_config_for(&file, gait)?;
+    let distance = match &scene {
+        Some(scene) => scene.walk_length(args.distance).context("--distance")?,
+        None => args.distance.unwrap_or(DEFAULT_DISTANCE_M),
+    };
     let request = WalkRequest {
         speed: walking_speed(args.speed, &file, gait)?,
-        ..WalkRequest::feet(args.distance, args.seed)
+        ..WalkRequest::feet(distance, args.seed)
     };
     let sequence = match &scene {
-        Some(scene) => source.walk_in(
-            &robot,
-            &params,
-            &WalkRequest {
-                distance: scene.path_length(),
-                ..request
-            },
-            &scene.walk_environment(),
-        )?,
+        Some(scene) => source.walk_in(&robot, &params, &request, &scene.walk_environment())?,
         None => source.walk(&robot, &params, &request)?,
     };
     let mut children = Processes::default();
@@ -329,7 +329,7 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
             let title = format!(
                 "{}, {} m, walkctl demo --physics {} --gait {}",
                 args.robot.name(),
-                args.distance,
+                distance,
                 args.physics.name(),
                 gait.name()
             );

@@ -107,8 +107,8 @@ pub struct EvaluateArgs {
     /// Faults to inject into every walk, and when.
     #[command(flatten)]
     pub inject: InjectArgs,
-    /// Walk every run through this scene (docs/scenes.md), from its start to its goal, instead
-    /// of on the flat floor; the path's length replaces `--distances`. Needs `--physics mujoco`.
+    /// Walk every run through this scene (docs/scenes.md), from its start towards its goal,
+    /// instead of on the flat floor: the whole path, or its first `--distances` metres.
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
     /// The stance source of every walk (default: the synthetic generator).
@@ -377,14 +377,7 @@ impl<'a> Subject<'a> {
 /// every run succeeded.
 pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
     let scene = crate::demo::load_scene(args.scene.as_deref())?;
-    let requests = match &scene {
-        Some(scene) => MatrixCells {
-            distances: vec![scene.path_length()],
-            ..args.cells.clone()
-        }
-        .requests()?,
-        None => args.cells.requests()?,
-    };
+    let requests = args.cells.requests(scene.as_ref())?;
     let source = args.source.load()?;
     let subjects = args
         .robots
@@ -577,10 +570,15 @@ fn run_once(
     if let Some(frames) = &frames {
         let _ = std::fs::remove_dir_all(frames);
         // The side camera looks at the middle of the walk: on the flat floor it starts at x = 0
-        // along +x; through a scene, between its start and its goal.
-        let middle = scene.map_or(Vector3::new(distance / 2.0, 0.0, 0.0), |scene| {
-            (scene.start.translation.vector + scene.goal) / 2.0
-        });
+        // along +x; through a scene, from its start along its heading, on the surface there.
+        let middle = match scene {
+            None => Point3::new(distance / 2.0, 0.0, 0.0),
+            Some(scene) => {
+                let on_path = scene.start * Point3::new(distance / 2.0, 0.0, 0.0);
+                let z = scene.environment.highest_at(on_path.x, on_path.y);
+                Point3::new(on_path.x, on_path.y, z.unwrap_or(on_path.z))
+            }
+        };
         let lookat = format!("{},{},{}", middle.x, middle.y, middle.z + 0.8);
         sim_args.extend(["--snapshots".into(), frames.into()]);
         sim_args.extend(["--snapshot-lookat".into(), lookat.into()]);

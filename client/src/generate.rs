@@ -24,10 +24,11 @@ pub struct GenerateArgs {
     pub urdf: Option<PathBuf>,
     /// Distance the post-processed walk should cover [m]; the raw sequence is generated for
     /// D / scf (the paper's rule), with scf from `[postprocess]` or `--scf`.
-    #[arg(long, value_name = "D", value_parser = DISTANCE_M.parser(), required_unless_present = "scene", conflicts_with = "scene")]
+    /// Through a `--scene`: its path's first D m, at most its length (default the whole path).
+    #[arg(long, value_name = "D", value_parser = DISTANCE_M.parser(), required_unless_present = "scene")]
     pub distance: Option<f64>,
-    /// Walk through this scene (docs/scenes.md) from its start to its goal: the distance is the
-    /// path's length, and the raw sequence carries the scene's surfaces and railings (in the
+    /// Walk through this scene (docs/scenes.md) from its start towards its goal (the whole path
+    /// or its first `--distance` metres), and the raw sequence carries the scene's surfaces and railings (in the
     /// walk's frame, starting at the origin) for `walkctl postprocess` to put the walk and its
     /// held hands onto. A held hand needs a scene with a railing.
     #[arg(long, value_name = "FILE")]
@@ -79,7 +80,7 @@ pub fn run(args: &GenerateArgs) -> anyhow::Result<()> {
     let scale = if args.raw_distance { 1.0 } else { 1.0 / scf };
     let scene = args.scene.as_deref().map(Scene::from_path).transpose()?;
     let walk_distance = match &scene {
-        Some(scene) => scene.path_length(),
+        Some(scene) => scene.walk_length(args.distance).context("--distance")?,
         None => args
             .distance
             .expect("clap requires --distance without --scene"),

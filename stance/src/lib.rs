@@ -48,6 +48,6 @@ pub use geometry::PathFrame;
 pub use params::{ContactUnification, Gait, GaitUnavailable, ParamsError, PostProcessParams};
 pub use pipeline::PostProcessor;
 pub use poses::PoseSequence;
-pub use scene::{Scene, SceneError};
+pub use scene::{BeyondPath, Scene, SceneError};
 pub use sequence::{NoRailing, PostProcessedSequence, RawSequence, Stance, StanceSequence};
 pub use walk::{WalkRequest, WalkingSpeed, synthetic_walk, walk_in};

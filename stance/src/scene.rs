@@ -376,6 +376,37 @@ impl Scene {
         let to_goal = self.goal - self.start.translation.vector;
         to_goal.xy().dot(&heading.xy())
     }
+
+    /// How far a walk through the scene goes: the whole path (`None`), or its first `requested`
+    /// metres, never past the goal (the scene checked its surfaces only as far as the goal).
+    pub fn walk_length(&self, requested: Option<f64>) -> Result<f64, BeyondPath> {
+        let length = self.path_length();
+        match requested {
+            None => Ok(length),
+            // Rounding in the length, not a longer walk.
+            Some(distance) if distance <= length + 1e-6 => Ok(distance.min(length)),
+            Some(distance) => Err(BeyondPath {
+                scene: self.name.clone(),
+                distance,
+                length,
+            }),
+        }
+    }
+}
+
+/// A walk asked to go further than a scene's path ([`Scene::walk_length`]).
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "scene \"{scene}\": a walk of {distance} m goes past its goal, {length:.3} m along the path; \
+     ask for at most that"
+)]
+pub struct BeyondPath {
+    /// The scene's name.
+    pub scene: String,
+    /// The distance asked for (m).
+    pub distance: f64,
+    /// The path's length (m).
+    pub length: f64,
 }
 
 /// A located [`SceneError::Toml`] from a `toml` error.
@@ -853,5 +884,19 @@ mod tests {
         let mut turned = scene.clone();
         turned.start.rotation = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.5);
         assert!((turned.path_length() - 4.7 * 0.5f64.cos()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_walk_goes_the_whole_path_or_its_first_metres_never_past_the_goal() {
+        let scene = committed("railing");
+        assert_eq!(scene.walk_length(None).unwrap(), 5.0);
+        assert_eq!(scene.walk_length(Some(1.0)).unwrap(), 1.0);
+        // Rounding in the length is the whole path.
+        assert_eq!(scene.walk_length(Some(5.0 + 1e-9)).unwrap(), 5.0);
+        let error = scene.walk_length(Some(5.5)).unwrap_err().to_string();
+        assert!(
+            error.contains("\"railing\"") && error.contains("5.5 m") && error.contains("5.000 m"),
+            "{error}"
+        );
     }
 }

@@ -2,8 +2,9 @@
 //! and distance, as both matrix commands report them: `walkctl evaluate` (walkd and walk-sim as
 //! processes) and walk-bench's `physics-matrix` (in process).
 
+use anyhow::Context;
 use serde::{Serialize, Serializer};
-use stance::{AffordanceSet, WalkRequest};
+use stance::{AffordanceSet, Scene, WalkRequest};
 
 use crate::args::DISTANCE_M;
 use crate::evaluate::actuators::ActuatorReport;
@@ -19,9 +20,10 @@ pub struct MatrixCells {
         default_value = "feet,feet+left-hand,feet+right-hand"
     )]
     pub affordances: Vec<AffordanceSet>,
-    /// Distances to walk (m, each 0.01-1000).
-    #[arg(long, value_delimiter = ',', default_value = "1,5", value_parser = DISTANCE_M.parser())]
-    pub distances: Vec<f64>,
+    /// Distances to walk (m, each 0.01-1000; default 1,5). Through a scene: the first D m of
+    /// its path, at most its length (default the whole path).
+    #[arg(long, value_delimiter = ',', value_parser = DISTANCE_M.parser())]
+    pub distances: Option<Vec<f64>>,
     /// Runs per affordance set and distance, 1-100000; run i uses generator seed
     /// `first_seed + i`.
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=100_000))]
@@ -31,21 +33,34 @@ pub struct MatrixCells {
     pub first_seed: u64,
 }
 
+/// The distances walked when `--distances` is not given on the flat floor (m).
+const DEFAULT_DISTANCES_M: [f64; 2] = [1.0, 5.0];
+
 impl MatrixCells {
-    /// Every walk, in matrix order: affordance set, then distance, then seed. Refuses no runs,
-    /// no cells, distances outside their range and seeds past `u64::MAX`.
-    pub fn requests(&self) -> anyhow::Result<Vec<WalkRequest>> {
+    /// Every walk, in matrix order: affordance set, then distance, then seed; through `scene`
+    /// if any. Refuses no runs, no cells, distances outside their range or longer than the
+    /// scene's path, and seeds past `u64::MAX`.
+    pub fn requests(&self, scene: Option<&Scene>) -> anyhow::Result<Vec<WalkRequest>> {
+        let distances = match (&self.distances, scene) {
+            (Some(distances), _) => distances.clone(),
+            (None, Some(scene)) => vec![scene.path_length()],
+            (None, None) => DEFAULT_DISTANCES_M.to_vec(),
+        };
         anyhow::ensure!(self.runs > 0, "--runs must be at least 1");
         anyhow::ensure!(
-            !self.affordances.is_empty() && !self.distances.is_empty(),
+            !self.affordances.is_empty() && !distances.is_empty(),
             "--affordances and --distances need at least one value each"
         );
         anyhow::ensure!(
-            self.distances.iter().all(|&d| DISTANCE_M.contains(d)),
-            "--distances {:?}: each {}",
-            self.distances,
+            distances.iter().all(|&d| DISTANCE_M.contains(d)),
+            "--distances {distances:?}: each {}",
             DISTANCE_M.requirement()
         );
+        if let Some(scene) = scene {
+            for &distance in &distances {
+                scene.walk_length(Some(distance)).context("--distances")?;
+            }
+        }
         anyhow::ensure!(
             self.first_seed.checked_add(self.runs - 1).is_some(),
             "--first-seed {} with --runs {}: the last seed would pass {}",
@@ -57,7 +72,7 @@ impl MatrixCells {
             .affordances
             .iter()
             .flat_map(|&affordances| {
-                self.distances.iter().flat_map(move |&distance| {
+                distances.iter().flat_map(move |&distance| {
                     (0..self.runs).map(move |i| WalkRequest {
                         distance,
                         affordances,
@@ -232,11 +247,11 @@ mod tests {
     fn requests_are_in_matrix_order_and_bad_cells_are_refused() {
         let cells = MatrixCells {
             affordances: vec![AffordanceSet::Feet, AffordanceSet::FeetRightHand],
-            distances: vec![1.0, 5.0],
+            distances: None,
             runs: 2,
             first_seed: 10,
         };
-        let requests = cells.requests().unwrap();
+        let requests = cells.requests(None).unwrap();
         assert_eq!(requests.len(), 8);
         assert_eq!(requests[0], WalkRequest::feet(1.0, 10));
         assert_eq!(requests[1], WalkRequest::feet(1.0, 11));
@@ -248,11 +263,11 @@ mod tests {
                 ..cells.clone()
             },
             MatrixCells {
-                distances: vec![1.0, -5.0],
+                distances: Some(vec![1.0, -5.0]),
                 ..cells.clone()
             },
             MatrixCells {
-                distances: vec![f64::NAN],
+                distances: Some(vec![f64::NAN]),
                 ..cells.clone()
             },
             MatrixCells {
@@ -260,8 +275,51 @@ mod tests {
                 ..cells.clone()
             },
         ] {
-            assert!(bad.requests().is_err(), "{bad:?} was accepted");
+            assert!(bad.requests(None).is_err(), "{bad:?} was accepted");
         }
+    }
+
+    #[test]
+    fn through_a_scene_the_path_is_walked_whole_or_its_first_metres_never_further() {
+        let scene = Scene::from_path(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../configs/scenes/railing.toml"),
+        )
+        .unwrap();
+        let cells = MatrixCells {
+            affordances: vec![AffordanceSet::FeetRightHand],
+            distances: None,
+            runs: 1,
+            first_seed: 0,
+        };
+        let whole = cells.requests(Some(&scene)).unwrap();
+        assert_eq!(whole.len(), 1);
+        assert!((whole[0].distance - 5.0).abs() < 1e-12);
+        let parts = MatrixCells {
+            distances: Some(vec![1.0, 5.0]),
+            ..cells.clone()
+        };
+        let distances: Vec<f64> = parts
+            .requests(Some(&scene))
+            .unwrap()
+            .iter()
+            .map(|request| request.distance)
+            .collect();
+        assert_eq!(distances, [1.0, 5.0]);
+        let error = MatrixCells {
+            distances: Some(vec![1.0, 5.5]),
+            ..cells
+        }
+        .requests(Some(&scene))
+        .unwrap_err();
+        let error = format!("{error:#}");
+        assert!(
+            error.contains("--distances")
+                && error.contains("\"railing\"")
+                && error.contains("5.5 m")
+                && error.contains("5.000 m"),
+            "{error}"
+        );
     }
 
     #[test]
