@@ -55,16 +55,14 @@ pub(crate) fn asked_share(
 
 /// Whether a hand is planned to carry while the walk moves towards stance `index` of `contacts`
 /// (the sequence's flags per stance): that stance holds it and the one before held it too, so a
-/// hand reaching for the rail is not yet meant to carry. An index past the end is the last
-/// stance; false without stances.
+/// hand reaching for the rail is not yet meant to carry. Towards stance 0 the walk leaves its
+/// standing start, hands free, so a hand the first stance holds is reaching too. An index past
+/// the end is the last stance; false without stances.
 pub fn hand_planned_held(contacts: &[[bool; 4]], index: usize) -> bool {
-    let Some(last) = contacts.len().checked_sub(1) else {
+    let (Some(last), Some(before)) = (contacts.len().checked_sub(1), index.checked_sub(1)) else {
         return false;
     };
-    let (now, before) = (
-        contacts[index.min(last)],
-        contacts[index.saturating_sub(1).min(last)],
-    );
+    let (now, before) = (contacts[index.min(last)], contacts[before.min(last)]);
     EndEffector::HANDS
         .iter()
         .any(|&h| now[h as usize] && before[h as usize])
@@ -164,6 +162,16 @@ mod tests {
         let share = asked_share(&contacts, &per_stance, 100.0).unwrap();
         assert!((share - 2.0).abs() < 1e-12, "{share}");
         assert_eq!(asked_share(&contacts, &per_stance[..2], 100.0), None);
+    }
+
+    #[test]
+    fn a_hand_the_first_stance_holds_is_reached_from_the_standing_start() {
+        let (feet, left) = ([true, true, false, false], [true, true, true, false]);
+        let contacts = [left, left, feet];
+        assert!(!hand_planned_held(&contacts, 0));
+        assert!(hand_planned_held(&contacts, 1));
+        assert!(!hand_planned_held(&contacts, 2));
+        assert!(!hand_planned_held(&[], 1));
     }
 
     #[test]
