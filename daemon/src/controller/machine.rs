@@ -13,6 +13,7 @@ use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
 
 use super::config::ControllerConfig;
 use super::gait::{distribute, force_difference_velocities};
+use super::hand_press::reach_goal;
 use super::hand_support::{HandLoad, HandSupport, hand_slot};
 use super::plan::{Step, TransitionPlan};
 use super::sequence::PreparedSequence;
@@ -734,7 +735,7 @@ impl StateMachine {
             }
             (Phase::Reach, Some(hand)) => {
                 let start = feedback.poses[hand as usize];
-                let goal = self.world_target(hand);
+                let goal = reach_goal(&self.world_target(hand), &c);
                 self.timed_motion(start, goal, Profile::MinimumJerk);
                 self.motion = self.motion.lifted(c.hand_approach_height_m);
                 self.motion.duration()
@@ -918,7 +919,7 @@ impl StateMachine {
             Phase::Reach => {
                 self.targets.contacts[i] = true;
                 self.carried[i] = None;
-                self.targets.anchors[i] = *self.motion.goal();
+                self.targets.anchors[i] = self.world_target(e);
             }
             Phase::Unload if !e.is_foot() => {
                 // The hand carries no more than a touch: let it go.

@@ -46,6 +46,7 @@ use super::sensing::{DcmEstimator, TiltRate, pressure_centre, tilted_com};
 use super::stabilizer::{Measured, Stabilizer};
 use super::swing::SwingTrajectory;
 use crate::controller::config::ControllerConfig;
+use crate::controller::hand_press::reach_goal;
 use crate::controller::machine::{
     Balance, ComHeight, Feedback, PoseTarget, Progress, Targets, heading_frame,
 };
@@ -113,7 +114,9 @@ pub(crate) struct DynamicWalker {
     stop: Option<Stop>,
     /// This tick lands swing feet by position, not by force-torque.
     blind: bool,
-    reaches: [Option<(PoseTrajectory, f64)>; 2],
+    /// Each hand's reach under way: its motion, its start on the plan clock (s) and the contact
+    /// it is for (world).
+    reaches: [Option<(PoseTrajectory, f64, Isometry3<f64>)>; 2],
     /// Released hands carried with the pelvis: their pose in its planar frame.
     carried: [Option<Isometry3<f64>>; 2],
     stabilizer: Stabilizer,
@@ -564,11 +567,12 @@ impl DynamicWalker {
                         Some(heading_frame(&feedback.pelvis).inverse() * self.targets.anchors[h]);
                 }
             } else if !self.targets.contacts[h] && contacts[h] {
-                let goal = self.to_world * targets[h];
+                let contact = self.to_world * targets[h];
+                let goal = reach_goal(&contact, &self.config);
                 let reach =
                     PoseTrajectory::new(feedback.poses[h], goal, duration, Profile::MinimumJerk)
                         .lifted(self.config.hand_approach_height_m);
-                self.reaches[k] = Some((reach, start));
+                self.reaches[k] = Some((reach, start, contact));
             }
         }
     }
@@ -576,10 +580,10 @@ impl DynamicWalker {
     /// The hands that reached are in contact.
     fn finish_transition(&mut self) {
         for (k, hand) in EndEffector::HANDS.iter().enumerate() {
-            if let Some((reach, _)) = self.reaches[k].take() {
+            if let Some((_, _, contact)) = self.reaches[k].take() {
                 let h = *hand as usize;
                 self.targets.contacts[h] = true;
-                self.targets.anchors[h] = *reach.goal();
+                self.targets.anchors[h] = contact;
                 self.carried[k] = None;
             }
         }
@@ -764,7 +768,7 @@ impl DynamicWalker {
                     pose: self.targets.anchors[h],
                     velocity: [0.0; 6],
                 })
-            } else if let Some((reach, start)) = &self.reaches[k] {
+            } else if let Some((reach, start, _)) = &self.reaches[k] {
                 let (pose, velocity) = reach.sample(self.clock - start);
                 Some(PoseTarget { pose, velocity })
             } else {
