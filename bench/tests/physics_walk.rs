@@ -269,7 +269,7 @@ mod walks {
     /// the rail and was held down (dynamic: fell 0.34 m along), and a hand let go on top of it
     /// was pressed into it (static: fell 0.13 m along).
     ///
-    /// The held hand carries weight (`hand_support_share`, 0.16 of it asked): the simulator's
+    /// The held hand carries weight (`hand_support_share`, 0.165 of it asked): the simulator's
     /// wrist forces average at least 0.15 of the weight while the hand is planned to carry, and
     /// leaning on it the robot stands with its CoM at least 3 cm outside its soles for a second
     /// (the single supports on its left foot, away from the rail). Before the balance counted

@@ -163,7 +163,7 @@ fn jvrc1_walks_under_mujoco_physics_without_falling() {
 /// A walk that holds the left hand on a railing, in a MuJoCo world without one (the flat
 /// floor): the hand presses on nothing (it sinks `hand_press_depth_m` at most, docs/controller.md,
 /// "Hands on a railing"); asked for its share of the weight (walkd's telemetry shows the force
-/// asked: JVRC-1's `hand_support_share` is 0.16), it is measured to carry none, so the CoM never
+/// asked: JVRC-1's `hand_support_share` is 0.165), it is measured to carry none, so the CoM never
 /// leans towards it ("Hands carry weight in the static gait"), and the walk goes on without it
 /// to the end, upright, the simulator reading no force on the palm.
 #[test]

@@ -271,7 +271,7 @@ impl Default for ControllerConfig {
             hand_press_speed: 0.05,
             hand_press_depth_m: 0.01,
             hand_press_slide_m: 0.1,
-            hand_support_share: 0.16,
+            hand_support_share: 0.165,
             hand_support_rate: 0.1,
             joint_limit_tolerance_rad: 0.03,
             workspace_radius_m: 100.0,
