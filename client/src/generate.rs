@@ -28,9 +28,9 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "D", value_parser = DISTANCE_M.parser(), required_unless_present = "scene")]
     pub distance: Option<f64>,
     /// Walk through this scene (docs/scenes.md) from its start towards its goal (the whole path
-    /// or its first `--distance` metres), and the raw sequence carries the scene's surfaces and railings (in the
-    /// walk's frame, starting at the origin) for `walkctl postprocess` to put the walk and its
-    /// held hands onto. A held hand needs a scene with a railing.
+    /// or its first `--distance` metres), and the raw sequence carries the scene's surfaces and
+    /// railings (in the walk's frame, starting at the origin) for `walkctl postprocess` to put
+    /// the walk and its held hands onto. A held hand needs a scene with a railing.
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
     /// Generate exactly D metres (no division by scf).
