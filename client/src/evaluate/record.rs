@@ -41,11 +41,10 @@ impl MatrixCells {
     /// if any. Refuses no runs, no cells, distances outside their range or longer than the
     /// scene's path, and seeds past `u64::MAX`.
     pub fn requests(&self, scene: Option<&Scene>) -> anyhow::Result<Vec<WalkRequest>> {
-        let distances = match (&self.distances, scene) {
-            (Some(distances), _) => distances.clone(),
-            (None, Some(scene)) => vec![scene.path_length()],
-            (None, None) => DEFAULT_DISTANCES_M.to_vec(),
-        };
+        let distances = self.distances.clone().unwrap_or_else(|| match scene {
+            Some(scene) => vec![scene.path_length()],
+            None => DEFAULT_DISTANCES_M.to_vec(),
+        });
         anyhow::ensure!(self.runs > 0, "--runs must be at least 1");
         anyhow::ensure!(
             !self.affordances.is_empty() && !distances.is_empty(),
@@ -56,11 +55,14 @@ impl MatrixCells {
             "--distances {distances:?}: each {}",
             DISTANCE_M.requirement()
         );
-        if let Some(scene) = scene {
-            for &distance in &distances {
-                scene.walk_length(Some(distance)).context("--distances")?;
-            }
-        }
+        let distances = match scene {
+            Some(scene) => distances
+                .iter()
+                .map(|&distance| scene.walk_length(Some(distance)))
+                .collect::<Result<Vec<_>, _>>()
+                .context("--distances")?,
+            None => distances,
+        };
         anyhow::ensure!(
             self.first_seed.checked_add(self.runs - 1).is_some(),
             "--first-seed {} with --runs {}: the last seed would pass {}",
