@@ -31,12 +31,10 @@ use nalgebra::{Isometry3, Vector3};
 use super::config::ControllerConfig;
 use super::machine::Targets;
 
-/// The held hands' target offsets (m, world; see the module docs).
+/// The held hands' target offsets (m, world; see the module docs); `None` for a hand not held.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct HandPress {
-    offsets: [Vector3<f64>; 2],
-    /// Which hands were held last tick (left, right).
-    held: [bool; 2],
+    offsets: [Option<Vector3<f64>>; 2],
 }
 
 /// Where a reach for a hand contact at `contact` (world) ends: `hand_press_depth_m` above it,
@@ -58,12 +56,7 @@ impl HandPress {
         config: &ControllerConfig,
         dt: f64,
     ) {
-        for ((offset, held), hand) in self
-            .offsets
-            .iter_mut()
-            .zip(&mut self.held)
-            .zip(EndEffector::HANDS)
-        {
+        for (slot, hand) in self.offsets.iter_mut().zip(EndEffector::HANDS) {
             let h = hand as usize;
             let wanted = Vector3::new(
                 0.0,
@@ -72,14 +65,12 @@ impl HandPress {
             );
             let (true, Some(task)) = (targets.contacts[h], targets.end_effectors[h].as_mut())
             else {
-                *offset = Vector3::zeros();
-                *held = false;
+                *slot = None;
                 continue;
             };
-            if !std::mem::replace(held, true) {
-                // Just held: from where its reach ended (`reach_goal`).
-                *offset = Vector3::new(0.0, 0.0, config.hand_press_depth_m);
-            }
+            // Just held: from where its reach ended (`reach_goal`).
+            let offset =
+                slot.get_or_insert_with(|| Vector3::new(0.0, 0.0, config.hand_press_depth_m));
             let force = Vector3::new(wrenches[h][0], wrenches[h][1], wrenches[h][2]);
             let speed = config.hand_press_speed;
             let step = (config.hand_admittance * (force - wanted)).map(|v| v.clamp(-speed, speed));
@@ -99,7 +90,7 @@ impl HandPress {
     /// The current offsets (m; left hand, right hand).
     #[cfg(test)]
     pub fn offsets(&self) -> [Vector3<f64>; 2] {
-        self.offsets
+        self.offsets.map(Option::unwrap_or_default)
     }
 }
 
