@@ -9,9 +9,9 @@
 //!
 //! During a swing — from its lift-off to the moment its sole came to rest
 //! ([`super::footholds::swings`]) — the clearance is the distance from the sole's bottom (the
-//! `[robot] sole` rectangle on the sole frame: the bottom face of MuJoCo's foot box) to each
-//! edge the rectangle passes over, along the sole's normal, at each end of the part of the edge
-//! under the rectangle (a plane and a straight edge: the least is at an end). Negative: the
+//! `[robot] sole` rectangle on the sole frame: the bottom face of MuJoCo's foot box) down to each
+//! edge the rectangle passes over, vertically, at each end of the part of the edge under the
+//! rectangle (a plane and a straight edge: the least is at an end). Negative: the
 //! edge is inside the foot box's bottom face, which MuJoCo's contact would not allow but for its
 //! compliance. Over an edge no higher than where the swing lifted off (up to [`DROP_M`] above:
 //! the nosing of the tread it steps down from) only a sole that is not rising counts: rising, it
@@ -22,7 +22,7 @@
 //! clearance is the least over its swings.
 
 use kinematics::robot::SoleRectangle;
-use nalgebra::{Isometry3, Point2, Point3, Vector2};
+use nalgebra::{Isometry3, Point2, Point3, Vector2, Vector3};
 use shm_types::SimTruth;
 use stance::Environment;
 
@@ -144,17 +144,24 @@ pub(crate) fn edge_clearance_m(
     least
 }
 
-/// The least distance from the sole rectangle at `pose` to the part of `edge` under it, along
-/// the sole's normal (m); `None` when the edge does not pass under the rectangle.
+/// The least height of the sole rectangle at `pose` over the part of `edge` vertically under it
+/// (m); `None` when the edge does not pass under the rectangle. Vertical, not along the sole's
+/// normal: a toe-off pitches the sole up to 0.5 rad, and the column along its normal then
+/// leans over the nosing ahead of a toe still behind the riser.
 fn clearance_over(pose: &Isometry3<f64>, edge: &Edge, sole: &SoleRectangle) -> Option<f64> {
-    let (a, b) = (
-        pose.inverse_transform_point(&edge.from),
-        pose.inverse_transform_point(&edge.to),
-    );
+    let normal = pose.rotation * Vector3::z();
+    if normal.z <= f64::EPSILON {
+        return None;
+    }
+    // The sole's plane is `height` above a point; the point under the plane is its projection.
+    let height = |q: &Point3<f64>| normal.dot(&(pose.translation.vector - q.coords)) / normal.z;
+    let (ha, hb) = (height(&edge.from), height(&edge.to));
+    let under = |q: &Point3<f64>, h: f64| pose.inverse_transform_point(&(q + Vector3::z() * h));
+    let (a, b) = (under(&edge.from, ha), under(&edge.to, hb));
     let half = Vector2::new(sole.length / 2.0, sole.width / 2.0);
     let [t0, t1] = clip(a.xy(), b.xy(), half)?;
-    let depth = |t: f64| -(a.z + (b.z - a.z) * t);
-    Some(depth(t0).min(depth(t1)))
+    let at = |t: f64| ha + (hb - ha) * t;
+    Some(at(t0).min(at(t1)))
 }
 
 /// The parameter interval `[t0, t1]` ⊂ [0, 1] of the segment `a → b` inside the rectangle
@@ -360,6 +367,27 @@ mod tests {
             touchdown: None,
         };
         assert_eq!(edge_clearance_m(&standing, &[later], &edges, &SOLE), None);
+        // A sole pitched 0.5 rad toe down about its toe, which rests 3 cm behind the riser
+        // (a toe-off): the nosing, 0.15 m up just ahead, is not under it, though the column
+        // along the sole's normal leans over it.
+        let pitched = Isometry3::new(
+            Vector3::new(0.97 - 0.1 * 0.5_f64.cos(), 0.0, 0.1 * 0.5_f64.sin()),
+            Vector3::new(0.0, 0.5, 0.0),
+        );
+        let nosing = edges
+            .iter()
+            .find(|e| (e.from.x - 1.0).abs() < 1e-6 && (e.to.x - 1.0).abs() < 1e-6)
+            .unwrap();
+        assert_eq!(clearance_over(&pitched, nosing, &SOLE), None);
+        // Raised 0.2 m and moved 5 cm on, its toe (x = 1.02, z = 0.2) is past the nosing: the
+        // sole's bottom is 0.02 m · tan 0.5 higher over it, 0.15 m up.
+        let over = Isometry3::from_parts(
+            (pitched.translation.vector + Vector3::new(0.05, 0.0, 0.2)).into(),
+            pitched.rotation,
+        );
+        let c = clearance_over(&over, nosing, &SOLE).unwrap();
+        let expected = 0.2 + 0.02 * 0.5_f64.tan() - 0.15;
+        assert!((c - expected).abs() < 1e-9, "{c} vs {expected}");
         // Without edges, nothing either.
         assert_eq!(edge_clearance_m(&standing, &[swing], &[], &SOLE), None);
     }
