@@ -262,6 +262,40 @@ mod walks {
         );
     }
 
+    /// JVRC-1's dynamic gait climbs the first 2 m of `stairs-up-15cm.toml` (seed 0: the floor,
+    /// then 0.15 m risers from 1 m along, both feet on each tread) to `done`, the soles ending at
+    /// least three stairs up. Its trailing heel rises about the toe before each swing up
+    /// (`toe_off_rad` 0.5): with the sole kept flat the robot tipped at the first stair and fell
+    /// after the fault in every walk (MuJoCo in process, seeds 0-3, and 1 of 10 over the
+    /// processes), the upper knee at its 100 N·m limit through the single support.
+    #[test]
+    fn jvrc1_climbs_15cm_stairs_on_its_toes() {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../configs/scenes/stairs-up-15cm.toml");
+        let scene = std::sync::Arc::new(stance::Scene::from_path(&file).expect("scene loads"));
+        let options = PhysicsWalkOptions {
+            scene: Some(scene.clone()),
+            ..PhysicsWalkOptions::dynamic()
+        };
+        let request = WalkRequest {
+            distance: 2.0,
+            affordances: AffordanceSet::Feet,
+            seed: 0,
+            speed: None,
+        };
+        let report = walk_distance(&config("jvrc1"), None, &request, &options).expect("walks");
+        let label = "jvrc1 dynamic stairs-up-15cm 2 m seed 0";
+        print_report(label, request.distance, &report);
+        assert_walked(label, &report, request.distance);
+        let last = report
+            .trace
+            .last()
+            .and_then(|s| s.sim)
+            .expect("a simulator trace");
+        let lower = last.left_foot.z.min(last.right_foot.z);
+        assert!(lower > 0.44, "{label}: the soles ended {lower:.3} m up");
+    }
+
     /// JVRC-1 walks the 5 m of `railing.toml`, the rail 0.45 m to its right at 0.8 m: with its
     /// feet alone in the dynamic gait, and holding the rail with its right hand in the static
     /// gait (seed 1, whose hand lets go on the rail whenever the right foot steps). Before free

@@ -595,9 +595,9 @@ fn the_estimate_turns_onto_the_imu_heading_no_faster_than_its_bound() {
 /// A stair higher than a gait is set to take (`max_step_up_m`, `max_step_down_m` of
 /// `[controller]` for the static gait, of `[gait.dynamic]` for the dynamic one) is refused
 /// before anything moves, naming the stance, the foot, the height and the key. JVRC-1's dynamic
-/// gait climbs 0.10 m stairs and walks down 0.15 m ones under MuJoCo; up 0.15 m and down 0.185 m
-/// it tipped at the first stair and fell after the fault. Its static gait takes the 10° ramp's
-/// steps, not a 0.10 m stair.
+/// gait climbs 0.15 m stairs (on its toes) and walks down 0.15 m ones under MuJoCo; up and down
+/// 0.185 m it tipped at the first stair and fell after the fault. Its static gait takes the 10°
+/// ramp's steps, not a 0.10 m stair.
 #[test]
 fn stairs_higher_than_a_gait_takes_are_refused_naming_the_step_and_the_key() {
     use stance::{AffordanceSet, Gait, PostProcessParams, Scene, WalkRequest};
@@ -624,15 +624,15 @@ fn stairs_higher_than_a_gait_takes_are_refused_naming_the_step_and_the_key() {
             .map(|_| ())
             .map_err(|refusal| refusal.to_string())
     };
-    assert_eq!(prepare("stairs-up-10cm.toml", Gait::Dynamic), Ok(()));
+    assert_eq!(prepare("stairs-up-15cm.toml", Gait::Dynamic), Ok(()));
     assert_eq!(prepare("stairs-down-15cm.toml", Gait::Dynamic), Ok(()));
     assert_eq!(prepare("ramp-10deg.toml", Gait::Static), Ok(()));
     for (scene, gait, step, key) in [
         (
-            "stairs-up-15cm.toml",
+            "stairs-up-18cm.toml",
             Gait::Dynamic,
-            "steps up 0.150 m",
-            "[gait.dynamic] max_step_up_m = 0.1,",
+            "steps up 0.185 m",
+            "[gait.dynamic] max_step_up_m = 0.15,",
         ),
         (
             "stairs-down-18cm.toml",

@@ -101,6 +101,33 @@ fn controller_tick_does_not_allocate() {
     count_allocations("jvrc1", "hold", || holding.closed.controller.hold());
     let end = walk_counting_allocations("jvrc1", holding, |_, _| {});
     assert_eq!(end, ControllerState::Holding);
+    // Up stairs: steps up, their heels rising about the toes before each (toe-off).
+    let end = walk_counting_allocations("jvrc1", up_the_stairs(), |_, _| {});
+    assert_eq!(end, ControllerState::Done);
+}
+
+/// JVRC-1 starting a dynamic walk up the first 1.6 m of `stairs-up-10cm.toml` (two stairs) on
+/// the kinematic simulator, standing on the scene's treads.
+fn up_the_stairs() -> walk_support::Harness {
+    let file = kinematics::ConfigFile::load(&walk_support::config_path("jvrc1")).unwrap();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../configs/scenes/stairs-up-10cm.toml");
+    let scene = stance::Scene::from_path(&path).expect("scene loads");
+    let params = stance::PostProcessParams::from_config_for(&file, stance::Gait::Dynamic).unwrap();
+    let request = stance::WalkRequest {
+        distance: 1.6,
+        affordances: stance::AffordanceSet::Feet,
+        seed: 0,
+        speed: None,
+    };
+    let environment = scene.walk_environment();
+    let mut h = walk_support::Harness::dynamic_on("jvrc1", 500.0, &environment);
+    let sequence = stance::walk_in(&h.robot, &params, &request, &environment, |options| {
+        stance::generate(&h.robot, options)
+    })
+    .expect("walks on the scene");
+    h.start_dynamic(&sequence, &walk_support::kinematic_gait_config("jvrc1"));
+    h
 }
 
 /// Runs `call` counting its allocations; asserts there were none.

@@ -224,6 +224,20 @@ impl Harness {
         Self::with_sim_options(name, controller_config(name), options, rate_hz)
     }
 
+    /// [`Harness::dynamic`] standing on the surfaces of `environment` (a scene's): the feet
+    /// stand on the treads a sequence post-processed into it steps onto.
+    pub fn dynamic_on(name: &str, rate_hz: f64, environment: &Environment) -> Self {
+        let robot = robot(name);
+        let options = SimOptions {
+            judge_by_zmp: true,
+            ..SimOptions::default()
+        };
+        let ground = Arc::new(sim_adapter::SceneGround::new(environment.clone()));
+        let sim = KinematicSim::on_ground(robot.clone(), robot.standing.clone(), options, ground)
+            .unwrap();
+        Self::around(robot, controller_config(name), sim, rate_hz)
+    }
+
     fn with_sim_options(
         name: &str,
         config: ControllerConfig,
@@ -231,9 +245,18 @@ impl Harness {
         rate_hz: f64,
     ) -> Self {
         let robot = robot(name);
-        let controller = Controller::new(robot.clone(), config, SolverKind::Dense).unwrap();
         let sim =
             KinematicSim::with_options(robot.clone(), robot.standing.clone(), options).unwrap();
+        Self::around(robot, config, sim, rate_hz)
+    }
+
+    fn around(
+        robot: Arc<Robot>,
+        config: ControllerConfig,
+        sim: KinematicSim,
+        rate_hz: f64,
+    ) -> Self {
+        let controller = Controller::new(robot.clone(), config, SolverKind::Dense).unwrap();
         let closed = ClosedLoop::new(controller, sim, rate_hz);
         Self {
             dt: closed.dt(),

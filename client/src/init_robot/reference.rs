@@ -88,7 +88,7 @@ pub const CONTROLLER: [(&str, Tuned); 44] = [
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic]`, in its order.
-pub const GAIT_DYNAMIC: [(&str, Tuned); 16] = [
+pub const GAIT_DYNAMIC: [(&str, Tuned); 18] = [
     ("single_support_s", Tuned::Number(0.55)),
     ("double_support_s", Tuned::Number(0.25)),
     ("initial_double_support_s", Tuned::Number(1.0)),
@@ -103,8 +103,10 @@ pub const GAIT_DYNAMIC: [(&str, Tuned); 16] = [
     ("hand_weight", Tuned::Number(0.02)),
     ("com_gain", Tuned::Number(3.0)),
     ("torso_posture_weight", Tuned::Number(1.0)),
-    ("max_step_up_m", Tuned::Number(0.1)),
+    ("max_step_up_m", Tuned::Number(0.15)),
     ("max_step_down_m", Tuned::Number(0.15)),
+    ("toe_off_rad", Tuned::Number(0.5)),
+    ("toe_off_s", Tuned::Number(0.3)),
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic.stabilizer]`, in its order.

@@ -109,12 +109,18 @@ pub struct DynamicGaitConfig {
     /// with a held hand fell. Absent: the `[controller]` value.
     pub torso_posture_weight: Option<f64>,
     /// Highest step up between consecutive contacts of one foot the dynamic gait takes (m); a
-    /// sequence with a higher one is refused (docs/scenes.md, "Step heights"). JVRC-1 climbs
-    /// 0.10 m stairs 10/10 under MuJoCo and tips at the first 0.15 m one.
+    /// sequence with a higher one is refused (docs/scenes.md, "Step heights"). With toe-off,
+    /// JVRC-1 climbs 0.15 m stairs 10/10 under MuJoCo and tips on 0.185 m ones.
     pub max_step_up_m: f64,
     /// Highest step down the dynamic gait takes (m): JVRC-1 walks down 0.15 m stairs 10/10 and
     /// tips at the first 0.185 m one, its trailing knee at its torque limit.
     pub max_step_down_m: f64,
+    /// The heel of a foot about to swing up a step rises about its toe by this pitch at the end
+    /// of the double support before (rad; 0: the sole stays flat), so the trailing leg reaches
+    /// farther (docs/scenes.md, "Toe-off").
+    pub toe_off_rad: f64,
+    /// How long before the lift-off the heel starts to rise (s; at most the double support).
+    pub toe_off_s: f64,
     /// The stabilizer closing the loop on force-torque and IMU.
     #[serde(skip)]
     pub stabilizer: StabilizerConfig,
@@ -174,8 +180,10 @@ impl Default for DynamicGaitConfig {
             com_gain: Some(DYNAMIC_COM_GAIN),
             zmp_inward_offset_m: 0.0,
             torso_posture_weight: Some(1.0),
-            max_step_up_m: 0.10,
+            max_step_up_m: 0.15,
             max_step_down_m: 0.15,
+            toe_off_rad: 0.5,
+            toe_off_s: 0.3,
             stabilizer: StabilizerConfig::default(),
         }
     }
@@ -495,6 +503,8 @@ impl DynamicGaitConfig {
             Bound::optional("torso_posture_weight", self.torso_posture_weight, 1e-6, 1e6),
             Bound::new("max_step_up_m", self.max_step_up_m, 0.0, 1.0),
             Bound::new("max_step_down_m", self.max_step_down_m, 0.0, 1.0),
+            Bound::new("toe_off_rad", self.toe_off_rad, 0.0, 0.8),
+            Bound::new("toe_off_s", self.toe_off_s, 0.01, 5.0),
         ]
     }
 }

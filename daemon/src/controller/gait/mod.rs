@@ -5,7 +5,8 @@
 //! When a sequence is prepared (off the real-time thread), its foot-contact changes become a
 //! timed [footstep plan](footsteps) and the plan's ZMP reference its [DCM pattern](dcm) by the
 //! closed-form backward recursion. On the control thread the [walker](walker) runs the plan on
-//! its clock: [swing](swing) trajectories for the lifted foot, FT-confirmed touchdowns, the
+//! its clock: [swing](swing) trajectories for the lifted foot, a [toe-off](toe_off) before a
+//! step up, FT-confirmed touchdowns, the
 //! [stabilizer](stabilizer) turning the measured DCM ([sensing]) into a desired ZMP inside the
 //! support and a pendulum-consistent CoM set-point, and the foot [compliance] tracking the
 //! desired ZMP's split between the feet. The QP is the static gait's, with the CoM height held
@@ -19,6 +20,7 @@ mod footsteps;
 mod sensing;
 mod stabilizer;
 mod swing;
+mod toe_off;
 mod walker;
 
 use kinematics::ground::GRAVITY;

@@ -15,6 +15,9 @@
 //!   stance foot; once force-torque confirms the contact the clock runs again. A touchdown still
 //!   missing `late_touchdown_max_s` after the planned instant is a fault.
 //!
+//! Before a foot swings up a step, its heel rises about its toe over the end of the double
+//! support ([toe-off](super::toe_off)); a stop that cancels the lift-off lowers it again.
+//!
 //! Hands change with the stance their phases lead to: a released hand leaves the contact set when
 //! its transition begins (carried along with the pelvis with `carry_released_hands`); an added
 //! hand reaches its contact pose with a minimum-jerk motion timed over the transition and is in
@@ -45,10 +48,11 @@ use super::footsteps::{FEET, Support, SupportPhase, SwingPlan};
 use super::sensing::{DcmEstimator, TiltRate, pressure_centre, tilted_com};
 use super::stabilizer::{Measured, Stabilizer};
 use super::swing::SwingTrajectory;
+use super::toe_off::ToeOff;
 use crate::controller::config::ControllerConfig;
 use crate::controller::hand_press::reach_goal;
 use crate::controller::machine::{
-    Balance, ComHeight, Feedback, PoseTarget, Progress, Targets, heading_frame,
+    Balance, ComHeight, Feedback, PoseTarget, Progress, STEP_HEIGHT_M, Targets, heading_frame,
 };
 use crate::controller::sequence::PreparedSequence;
 use crate::controller::sequencer::on_both_feet;
@@ -123,6 +127,8 @@ pub(crate) struct DynamicWalker {
     estimator: DcmEstimator,
     tilt_rate: TiltRate,
     tilt_damping: TiltDamping,
+    /// The heel rising about the toe of the foot about to swing up a step, if one is.
+    toe_off: Option<(EndEffector, ToeOff)>,
     /// The foot damping's rotation of each foot since it landed (world x, y; rad).
     foot_turn: [Vector2<f64>; 2],
     support: SupportPolygon,
@@ -163,6 +169,7 @@ impl DynamicWalker {
             estimator: DcmEstimator::default(),
             tilt_rate: TiltRate::default(),
             tilt_damping: TiltDamping::default(),
+            toe_off: None,
             foot_turn: [Vector2::zeros(); 2],
             support: SupportPolygon::empty(),
             targets,
@@ -344,6 +351,7 @@ impl DynamicWalker {
             self.stop = None;
         }
         self.stabilize(feedback, sensors, dt);
+        self.raise_heel();
         self.refresh_targets(&feedback.pelvis);
         progress
     }
@@ -392,6 +400,7 @@ impl DynamicWalker {
         self.tilt_rate.reset();
         self.tilt_damping.reset();
         self.foot_turn = [Vector2::zeros(); 2];
+        self.toe_off = None;
         self.started = true;
         self.clock = 0.0;
         self.phase = 0;
@@ -523,6 +532,7 @@ impl DynamicWalker {
             next.duration_s,
         );
         self.targets.contacts[foot as usize] = false;
+        self.toe_off = None;
         self.swing = Some(Swing {
             foot,
             trajectory,
@@ -688,8 +698,10 @@ impl DynamicWalker {
         let inward = self.plan().config.zmp_inward_offset_m;
         let loads = distribute(zmp, feet, &self.sole, config.zmp_margin_m, inward);
         let forces = FEET.map(|f| sensors.wrenches[f as usize][2]);
+        let toe_off = self.toe_off.map(|(foot, _)| foot as usize);
         for f in 0..2 {
-            let (Some(load), true) = (loads[f], config.foot_damping) else {
+            let (Some(load), true, false) = (loads[f], config.foot_damping, toe_off == Some(f))
+            else {
                 self.foot_turn[f] = Vector2::zeros();
                 continue;
             };
@@ -722,6 +734,56 @@ impl DynamicWalker {
                 }
             }
         }
+    }
+
+    /// Toe-off (module [`super::toe_off`]): in the double support before a foot swings up a
+    /// step, its heel rises about its toe over the support's last `toe_off_s`; a stop that
+    /// cancels the lift-off lowers it again over as long.
+    fn raise_heel(&mut self) {
+        let config = self.plan().config;
+        let phase = self.current_phase();
+        let lifting = match phase.map(|p| p.support) {
+            Some(Support::Double {
+                lift_off: Some(foot),
+            }) if self.stop.is_none() => Some(foot),
+            _ => None,
+        };
+        if self.toe_off.is_none() {
+            let (Some(foot), Some(phase)) = (lifting, phase) else {
+                return;
+            };
+            let duration = config.toe_off_s.min(phase.duration_s);
+            let start = phase.end_s() - duration;
+            if config.toe_off_rad <= 0.0 || self.clock < start || !self.climbs(foot) {
+                return;
+            }
+            self.toe_off = Some((foot, ToeOff::rise(start, config.toe_off_rad, duration)));
+        }
+        let Some((foot, toe_off)) = &mut self.toe_off else {
+            return;
+        };
+        let e = *foot as usize;
+        if lifting != Some(*foot) {
+            toe_off.lower(self.clock);
+        }
+        let velocity = toe_off.update(&mut self.targets.anchors[e], &self.sole, self.clock);
+        for (k, v) in velocity.iter().enumerate() {
+            self.targets.contact_velocity[e][k] += v;
+        }
+        if toe_off.lowered() {
+            self.toe_off = None;
+        }
+    }
+
+    /// The swing after this phase takes `foot` more than [`STEP_HEIGHT_M`] up.
+    fn climbs(&self, foot: EndEffector) -> bool {
+        let next = self.plan().footsteps.phases.get(self.phase + 1);
+        let Some(Support::Single(swing)) = next.map(|p| p.support) else {
+            return false;
+        };
+        let rise = (self.to_world * swing.landing).translation.z
+            - self.targets.anchors[foot as usize].translation.z;
+        swing.foot == foot && rise > STEP_HEIGHT_M
     }
 
     /// Mean height of the feet in contact (the surface the pendulum stands on).
