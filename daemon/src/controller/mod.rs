@@ -334,7 +334,12 @@ impl Controller {
         };
         let dynamic = gaits.dynamic().map_err(|e| Refusal(e.to_string()))?;
         let mut prepared = PreparedSequence::new(robot, config, &dynamic.step_heights(), seq)?;
-        let plan = DynamicPlan::new(robot, &prepared.stances, dynamic)?;
+        let plan = DynamicPlan::new(
+            robot,
+            &prepared.stances,
+            dynamic,
+            config.velocity_limit_scale,
+        )?;
         prepared.dynamic = Some(Box::new(plan));
         Ok(prepared)
     }

@@ -49,14 +49,19 @@ pub(crate) struct DynamicPlan {
     pub footsteps: FootstepPlan,
     /// The ZMP reference and its DCM (sequence frame until the walk starts).
     pub pattern: DcmPattern,
+    /// The fastest the heel may turn in a toe-off (rad/s): [`toe_off::TOE_OFF_SPEED_SHARE`] of
+    /// the slowest leg joint's speed bound.
+    pub toe_off_speed: f64,
 }
 
 impl DynamicPlan {
-    /// Plans `stances` (validated, sequence frame) for `robot` standing on both feet.
+    /// Plans `stances` (validated, sequence frame) for `robot` standing on both feet, its joints
+    /// turning at most `velocity_limit_scale` of their URDF speed.
     pub fn new(
         robot: &Robot,
         stances: &[PreparedStance],
         config: &DynamicGaitConfig,
+        velocity_limit_scale: f64,
     ) -> Result<Self, Refusal> {
         let model = &robot.model;
         let mut kinematics = Kinematics::new(model);
@@ -90,11 +95,19 @@ impl DynamicPlan {
         }
         let omega = (GRAVITY / com_height).sqrt();
         let pattern = DcmPattern::new(&footsteps.phases, omega, inward);
+        let limits = model.joint_limits();
+        let slowest_leg = robot
+            .joint_groups
+            .legs
+            .iter()
+            .map(|&j| limits[j].velocity)
+            .fold(f64::INFINITY, f64::min);
         Ok(Self {
             config: *config,
             com_height,
             footsteps,
             pattern,
+            toe_off_speed: toe_off::TOE_OFF_SPEED_SHARE * velocity_limit_scale * slowest_leg,
         })
     }
 }

@@ -23,6 +23,22 @@ fn about_toe(sole: &SoleRectangle, pitch: f64) -> Isometry3<f64> {
         * Isometry3::from_parts(toe.inverse(), UnitQuaternion::identity())
 }
 
+/// The fastest a leg joint may turn for the heel to rise, relative to the slowest leg joint's
+/// speed bound in the QP (`velocity_limit_scale` × its URDF speed): the rest is left for the leg's
+/// other motion. At JVRC-1's 0.5 rad in 0.3 s the heel turns at 3.1 rad/s at most, 0.7 of its
+/// hip's 4.45 rad/s; ARMAR-4's legs, bounded to 0.86 rad/s, made the QP infeasible
+/// (`qp_infeasible` at the first stair) at that pitch.
+pub(crate) const TOE_OFF_SPEED_SHARE: f64 = 0.75;
+
+/// The peak speed of a minimum-jerk motion over its mean speed (30/16).
+const MINIMUM_JERK_PEAK: f64 = 1.875;
+
+/// The pitch (rad) the heel rises to over `duration` (s): `max_pitch`, or less if reaching it
+/// would turn the foot faster than `max_speed` (rad/s).
+pub(crate) fn reachable_pitch(max_pitch: f64, max_speed: f64, duration: f64) -> f64 {
+    max_pitch.min(max_speed * duration / MINIMUM_JERK_PEAK)
+}
+
 /// A heel rising about the toe of one foot in contact, or coming back down.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct ToeOff {
@@ -128,6 +144,20 @@ mod tests {
         assert_eq!(toe_off.pitch, 0.25);
         let toe = |pose: &Isometry3<f64>| pose * Point3::new(0.1, 0.0, 0.0);
         assert!((toe(&anchor) - toe(&base)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn a_pitch_too_fast_for_the_legs_is_lowered_to_what_they_turn() {
+        assert_eq!(reachable_pitch(0.5, 4.45, 0.3), 0.5);
+        let pitch = reachable_pitch(0.5, 0.64, 0.3);
+        assert!(pitch < 0.11, "{pitch}");
+        let mut toe_off = ToeOff::rise(0.0, pitch, 0.3);
+        let mut anchor = Isometry3::identity();
+        let dt = 1e-3;
+        let fastest = (1..300)
+            .map(|k| toe_off.update(&mut anchor, &SOLE, f64::from(k) * dt)[4])
+            .fold(0.0, f64::max);
+        assert!((fastest - 0.64).abs() < 1e-3, "{fastest}");
     }
 
     #[test]

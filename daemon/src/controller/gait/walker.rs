@@ -48,7 +48,7 @@ use super::footsteps::{FEET, Support, SupportPhase, SwingPlan};
 use super::sensing::{DcmEstimator, TiltRate, pressure_centre, tilted_com};
 use super::stabilizer::{Measured, Stabilizer};
 use super::swing::SwingTrajectory;
-use super::toe_off::ToeOff;
+use super::toe_off::{ToeOff, reachable_pitch};
 use crate::controller::config::ControllerConfig;
 use crate::controller::hand_press::reach_goal;
 use crate::controller::machine::{
@@ -757,7 +757,8 @@ impl DynamicWalker {
             if config.toe_off_rad <= 0.0 || self.clock < start || !self.climbs(foot) {
                 return;
             }
-            self.toe_off = Some((foot, ToeOff::rise(start, config.toe_off_rad, duration)));
+            let pitch = reachable_pitch(config.toe_off_rad, self.plan().toe_off_speed, duration);
+            self.toe_off = Some((foot, ToeOff::rise(start, pitch, duration)));
         }
         let Some((foot, toe_off)) = &mut self.toe_off else {
             return;
