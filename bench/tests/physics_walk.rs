@@ -37,6 +37,14 @@ mod walks {
             .join(format!("{robot}.toml"))
     }
 
+    /// `configs/scenes/<name>.toml`, loaded.
+    fn scene(name: &str) -> std::sync::Arc<stance::Scene> {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../configs/scenes")
+            .join(format!("{name}.toml"));
+        std::sync::Arc::new(stance::Scene::from_path(&file).expect("scene loads"))
+    }
+
     /// `configs/<robot>.toml`, loaded.
     fn config(robot: &str) -> kinematics::ConfigFile {
         kinematics::ConfigFile::load(&config_path(robot)).expect("vendored config loads")
@@ -225,9 +233,7 @@ mod walks {
     /// the bound is raised here to walk into the step.)
     #[test]
     fn jvrc1_takes_back_a_static_step_down_beyond_its_reach() {
-        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../configs/scenes/stairs-down-10cm.toml");
-        let scene = std::sync::Arc::new(stance::Scene::from_path(&file).expect("scene loads"));
+        let scene = scene("stairs-down-10cm");
         let options = PhysicsWalkOptions {
             gait: stance::Gait::Static,
             scene: Some(scene.clone()),
@@ -270,9 +276,7 @@ mod walks {
     /// processes), the upper knee at its 100 N·m limit through the single support.
     #[test]
     fn jvrc1_climbs_15cm_stairs_on_its_toes() {
-        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../configs/scenes/stairs-up-15cm.toml");
-        let scene = std::sync::Arc::new(stance::Scene::from_path(&file).expect("scene loads"));
+        let scene = scene("stairs-up-15cm");
         let options = PhysicsWalkOptions {
             scene: Some(scene.clone()),
             ..PhysicsWalkOptions::dynamic()
@@ -310,9 +314,7 @@ mod walks {
     /// the hand (a 10 N touch) the share was 0.017 and the CoM never left the soles.
     #[test]
     fn jvrc1_walks_beside_a_railing_leaning_on_its_held_hand() {
-        let file =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/scenes/railing.toml");
-        let scene = std::sync::Arc::new(stance::Scene::from_path(&file).expect("scene loads"));
+        let scene = scene("railing");
         for (gait, affordances, seed) in [
             (stance::Gait::Dynamic, AffordanceSet::Feet, 0),
             (stance::Gait::Static, AffordanceSet::FeetRightHand, 1),
