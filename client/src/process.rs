@@ -289,7 +289,9 @@ impl Launch {
 /// assignments (`walkd --set`; `walk_bench::kinematic_gaits` applies them in process). Its robot
 /// is rigid: the stabilizer parts that act through contact compliance, foot damping and tilt
 /// damping, turn its whole body instead of shifting its centres of pressure, and their loops
-/// diverge (docs/controller.md, "The kinematic simulator and dynamic walks"). None for a config
+/// diverge (docs/controller.md, "The kinematic simulator and dynamic walks"). Its soles are flat
+/// contacts, released once lifted above their anchors, so a toe-off's raised heel reads as a
+/// foot let go: toe-off is off too. None for a config
 /// without `[gait.dynamic]`: it has no stabilizer, and setting these keys would create one.
 pub fn kinematic_sim_settings(file: &ConfigFile) -> &'static [&'static str] {
     let dynamic = file
@@ -299,6 +301,7 @@ pub fn kinematic_sim_settings(file: &ConfigFile) -> &'static [&'static str] {
         &[
             "gait.dynamic.stabilizer.foot_damping=false",
             "gait.dynamic.stabilizer.tilt_damping=false",
+            "gait.dynamic.toe_off_rad=0",
         ]
     } else {
         &[]
@@ -354,6 +357,8 @@ mod tests {
             "gait.dynamic.stabilizer.foot_damping=false",
             "--set",
             "gait.dynamic.stabilizer.tilt_damping=false",
+            "--set",
+            "gait.dynamic.toe_off_rad=0",
         ];
         let walk = PlantArgs::new(Physics::Kinematic, Gait::Dynamic, &dynamic);
         assert_eq!(walk.walkd, walkd);

@@ -5,10 +5,12 @@
 //! - a foot released (double → single support): a double-support phase (the ZMP crosses to the
 //!   foot that stays), at whose end the foot lifts off; it lasts `double_support_s`, the first
 //!   one `initial_double_support_s`, so the CoM can start from rest, and one next to a step up
-//!   or down (after its touchdown or before its lift-off) `step_double_support_s`;
+//!   or down (after its touchdown or before its lift-off) `step_double_support_s`, next to a
+//!   stair climbed (level soles) with no other step on its other side `climb_double_support_s`;
 //! - a foot added (single → double support): the single-support phase in which it swings, from
 //!   lift-off through the highest post-processed swing pose of its flight to its contact pose;
-//!   it lasts `single_support_s` (a step up or down: `step_single_support_s`);
+//!   it lasts `single_support_s` (a stair climbed: `climb_single_support_s`; any other step
+//!   up or down: `step_single_support_s`);
 //! - a foot added and the other released at once (single support on one foot, then on the
 //!   other): that swing, then a double support of `double_support_s` before the lift-off;
 //! - only hands change: a double support of `hand_transition_s` while they reach;
@@ -29,7 +31,7 @@
 use std::ops::Range;
 
 use kinematics::robot::EndEffector;
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Vector3};
 
 use super::config::DynamicGaitConfig;
 use crate::controller::machine::STEP_HEIGHT_M;
@@ -107,11 +109,11 @@ struct Builder<'a> {
     clock: f64,
     /// Planned poses of the feet on the ground.
     feet: [Option<Isometry3<f64>>; 2],
-    /// The swing under way: its foot, the highest swing pose so far and its lift-off height.
-    swing: Option<(EndEffector, Isometry3<f64>, f64)>,
+    /// The swing under way: its foot, the highest swing pose so far and its lift-off pose.
+    swing: Option<(EndEffector, Isometry3<f64>, Isometry3<f64>)>,
     stepped: bool,
-    /// Whether the last touchdown ended a step up or down.
-    after_step: bool,
+    /// How the last touchdown's swing changed height.
+    after_step: Rise,
     /// The sequence's time in the current support since its previous phase.
     dwell: Dwell,
 }
@@ -156,7 +158,7 @@ impl FootstepPlan {
             feet: standing.map(Some),
             swing: None,
             stepped: false,
-            after_step: false,
+            after_step: Rise::Level,
             dwell: Dwell::Empty,
         };
         let mut hands = [false; 2];
@@ -273,15 +275,17 @@ impl Builder<'_> {
         }
         for f in 0..2 {
             if released[f] {
-                let lift_off_z = self.feet[f].map_or(0.0, |foot| foot.translation.z);
+                let lift_off = self.feet[f].unwrap_or_else(Isometry3::identity);
                 let step_ahead = upcoming
                     .iter()
                     .find(|s| s.contacts[FEET[f] as usize])
-                    .is_some_and(|s| is_step(lift_off_z, &s.targets[FEET[f] as usize]));
+                    .map_or(Rise::Level, |s| {
+                        Rise::of(&lift_off, &s.targets[FEET[f] as usize])
+                    });
                 let duration = self.lift_off_double_support(step_ahead);
                 self.double_support(duration, Some(FEET[f]));
                 self.feet[f] = None;
-                self.swing = Some((FEET[f], stance.targets[FEET[f] as usize], lift_off_z));
+                self.swing = Some((FEET[f], stance.targets[FEET[f] as usize], lift_off));
             }
         }
         let feet_change = added.iter().chain(&released).any(|c| *c);
@@ -300,12 +304,18 @@ impl Builder<'_> {
     /// support's previous phase, if all timed, else `double_support_s`; the first lift-off from
     /// standing no shorter than `initial_double_support_s` (the CoM starts from rest), and one
     /// after a step up or down or before one (`step_ahead`) no shorter than
+    /// `climb_double_support()` when both are level or a stair climbed, else
     /// `step_double_support()`.
-    fn lift_off_double_support(&mut self, step_ahead: bool) -> (f64, PhaseTiming) {
+    fn lift_off_double_support(&mut self, step_ahead: Rise) -> (f64, PhaseTiming) {
         let limits = self.timing.timed_double_support();
         let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
-        if self.stepped && (step_ahead || self.after_step) {
-            let step = self.timing.step_double_support();
+        let sides = [step_ahead, self.after_step];
+        if self.stepped && sides.iter().any(|r| *r != Rise::Level) {
+            let step = if sides.contains(&Rise::Step) {
+                self.timing.step_double_support()
+            } else {
+                self.timing.climb_double_support()
+            };
             timed(dwell, step, limits, step)
         } else if self.stepped {
             timed(dwell, self.timing.double_support_s, limits, 0.0)
@@ -315,32 +325,33 @@ impl Builder<'_> {
         }
     }
 
-    /// The single support of a swing from `lift_off_z` to `landing`: the stances its foot was in
-    /// the air, if all timed, else `single_support_s`; a step up or down no shorter than
+    /// The single support of a swing from `lift_off` to `landing`: the stances its foot was in
+    /// the air, if all timed, else `single_support_s`; a stair climbed no shorter than
+    /// `climb_single_support()`, any other step up or down no shorter than
     /// `step_single_support()`.
     fn swing_single_support(
         &mut self,
-        lift_off_z: f64,
+        lift_off: &Isometry3<f64>,
         landing: &Isometry3<f64>,
     ) -> (f64, PhaseTiming) {
         let limits = self.timing.timed_single_support();
         let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
-        if is_step(lift_off_z, landing) {
-            let step = self.timing.step_single_support();
-            timed(dwell, step, limits, step)
-        } else {
-            timed(dwell, self.timing.single_support_s, limits, 0.0)
-        }
+        let step = match Rise::of(lift_off, landing) {
+            Rise::Level => return timed(dwell, self.timing.single_support_s, limits, 0.0),
+            Rise::Stair => self.timing.climb_single_support(),
+            Rise::Step => self.timing.step_single_support(),
+        };
+        timed(dwell, step, limits, step)
     }
 
     /// The single support in which the swing under way lands `foot` at `landing`.
     fn touchdown(&mut self, foot: EndEffector, landing: Isometry3<f64>) {
-        let (swinging, apex, lift_off_z) = self
+        let (swinging, apex, lift_off) = self
             .swing
             .take()
             .expect("a foot is added only while it is in the air");
         debug_assert_eq!(swinging, foot);
-        let duration = self.swing_single_support(lift_off_z, &landing);
+        let duration = self.swing_single_support(&lift_off, &landing);
         self.push(
             Support::Single(SwingPlan {
                 foot,
@@ -351,7 +362,7 @@ impl Builder<'_> {
         );
         self.feet[slot(foot)] = Some(landing);
         self.stepped = true;
-        self.after_step = is_step(lift_off_z, &landing);
+        self.after_step = Rise::of(&lift_off, &landing);
     }
 
     fn double_support(&mut self, duration: (f64, PhaseTiming), lift_off: Option<EndEffector>) {
@@ -386,10 +397,35 @@ fn timed(dwell: Dwell, configured: f64, [min, max]: [f64; 2], floor: f64) -> (f6
 }
 
 /// Index of a foot in the `[_; 2]` arrays.
-/// Whether a swing from `lift_off_z` landing at `landing` steps up or down (a stair, a ramp):
-/// its heights differ by more than [`STEP_HEIGHT_M`].
-fn is_step(lift_off_z: f64, landing: &Isometry3<f64>) -> bool {
-    (landing.translation.z - lift_off_z).abs() > STEP_HEIGHT_M
+/// How a swing changes height.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Rise {
+    /// Its heights differ by no more than [`STEP_HEIGHT_M`].
+    Level,
+    /// Up from a level sole to a level sole: a stair climbed (`climb_*` timing).
+    Stair,
+    /// Any other step: down, or up or onto a slope (`step_*` timing).
+    Step,
+}
+
+/// A sole tilted less than this from horizontal is level (rad): a stair's tread, not a ramp.
+const LEVEL_SOLE_RAD: f64 = 0.02;
+
+impl Rise {
+    /// A swing from `lift_off` landing at `landing`.
+    fn of(lift_off: &Isometry3<f64>, landing: &Isometry3<f64>) -> Self {
+        let rise = landing.translation.z - lift_off.translation.z;
+        let level = |pose: &Isometry3<f64>| {
+            (pose.rotation * Vector3::z()).angle(&Vector3::z()) < LEVEL_SOLE_RAD
+        };
+        if rise.abs() <= STEP_HEIGHT_M {
+            Self::Level
+        } else if rise > 0.0 && level(lift_off) && level(landing) {
+            Self::Stair
+        } else {
+            Self::Step
+        }
+    }
 }
 
 fn slot(foot: EndEffector) -> usize {
@@ -405,7 +441,7 @@ mod tests {
     use nalgebra::{DVector, Translation3};
 
     use super::*;
-    use crate::controller::gait::config::STEP_DOUBLE_SUPPORT_FACTOR;
+    use crate::controller::gait::config::CLIMB_DOUBLE_SUPPORT_FACTOR;
 
     const LF: usize = EndEffector::LeftFoot as usize;
     const RF: usize = EndEffector::RightFoot as usize;
@@ -456,7 +492,7 @@ mod tests {
     }
 
     #[test]
-    fn a_step_up_takes_the_step_single_support() {
+    fn a_stair_climbed_takes_the_climb_single_support() {
         let timing = DynamicGaitConfig::default();
         let stances = [
             stance(DS, standing()[0], standing()[1]),
@@ -467,13 +503,45 @@ mod tests {
         ];
         let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
         let singles = durations(&plan, true);
-        // The left foot up 0.10 m: a step; the right up 0.005 m: a flat step (its swing pose's
+        // The left foot up 0.10 m: a stair; the right up 0.005 m: a flat step (its swing pose's
         // height does not count).
         assert_eq!(
             singles,
-            [timing.step_single_support(), timing.single_support_s]
+            [timing.climb_single_support(), timing.single_support_s]
         );
-        assert!(timing.step_single_support() > timing.single_support_s);
+        assert!(timing.climb_single_support() > timing.single_support_s);
+    }
+
+    #[test]
+    fn a_step_down_or_up_a_slope_takes_the_step_timing() {
+        let timing = DynamicGaitConfig::default();
+        let pitched = |x: f64, y: f64, z: f64| {
+            Isometry3::new(
+                nalgebra::Vector3::new(x, y, z),
+                nalgebra::Vector3::y() * -0.17,
+            )
+        };
+        let stances = [
+            stance(DS, standing()[0], standing()[1]),
+            // Left down 0.10 m, then right up 0.05 m onto a 10 degree slope.
+            stance(LEFT_UP, at(0.15, 0.1, 0.0), standing()[1]),
+            stance(DS, at(0.3, 0.1, -0.1), standing()[1]),
+            stance(RIGHT_UP, at(0.3, 0.1, -0.1), at(0.15, -0.1, 0.1)),
+            stance(DS, at(0.3, 0.1, -0.1), pitched(0.3, -0.1, 0.05)),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        let step = timing.step_single_support();
+        assert_eq!(durations(&plan, true), [step, step]);
+        let step = timing.step_double_support();
+        assert_eq!(
+            durations(&plan, false),
+            [
+                timing.initial_double_support_s,
+                step,
+                timing.final_double_support_s
+            ]
+        );
+        assert!(timing.step_single_support() > timing.climb_single_support());
     }
 
     #[test]
@@ -495,21 +563,21 @@ mod tests {
         ];
         let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
         let doubles = durations(&plan, false);
-        let (step, flat) = (timing.step_double_support(), timing.double_support_s);
+        let (climb, flat) = (timing.climb_double_support(), timing.double_support_s);
         // The first lift-off from standing; before the right's step up; between the two steps
         // up; after the left's step up; between two flat steps; the final rest.
         assert_eq!(
             doubles,
             [
                 timing.initial_double_support_s,
-                step,
-                step,
-                step,
+                climb,
+                climb,
+                climb,
                 flat,
                 timing.final_double_support_s
             ]
         );
-        assert!((step - STEP_DOUBLE_SUPPORT_FACTOR * flat).abs() < 1e-12);
+        assert!((climb - CLIMB_DOUBLE_SUPPORT_FACTOR * flat).abs() < 1e-12);
     }
 
     #[test]
@@ -691,7 +759,7 @@ mod tests {
     }
 
     #[test]
-    fn a_timed_step_up_is_no_shorter_than_the_step_single_support() {
+    fn a_timed_stair_climbed_is_no_shorter_than_the_climb_single_support() {
         let timing = DynamicGaitConfig::default();
         let step = |duration_s| {
             let stances = [
@@ -706,8 +774,8 @@ mod tests {
             (plan.phases[1].duration_s, plan.phases[1].timing)
         };
         assert_eq!(
-            step(0.75),
-            (timing.step_single_support(), PhaseTiming::Clamped)
+            step(0.6),
+            (timing.climb_single_support(), PhaseTiming::Clamped)
         );
         assert_eq!(step(1.5), (1.5, PhaseTiming::Sequence));
     }
