@@ -3,24 +3,22 @@
 //! already over the upper foot, reaches farther and the CoM starts the single support higher.
 //!
 //! The foot stays in the contact set, held by its anchor; the anchor turns about the sole's front
-//! edge by a pitch that rises with a minimum-jerk profile to `toe_off_rad` over the last
-//! `toe_off_s` of the double support, and the turn's velocity is fed forward to the contact
+//! edge by a pitch that rises with a minimum-jerk profile to `toe_off_rad` (less where the legs
+//! cannot turn the foot that fast: [`reachable_pitch`]) over the last `toe_off_s` of the double
+//! support, and the turn's velocity is fed forward to the contact
 //! constraint. The pitch is applied relative to the foot's flat anchor, which is recovered each
 //! tick from the anchor and the pitch applied last, so anchors moved by the estimate's heading
 //! stay consistent.
 
 use kinematics::robot::SoleRectangle;
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
 
 use crate::controller::trajectory::Profile;
 
 /// The sole frame turned by `pitch` (rad, heel up) about its front edge, in the sole's frame.
 fn about_toe(sole: &SoleRectangle, pitch: f64) -> Isometry3<f64> {
-    let toe = Translation3::new(sole.length / 2.0, 0.0, 0.0);
     let turn = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), pitch);
-    Isometry3::from_parts(toe, UnitQuaternion::identity())
-        * Isometry3::from_parts(Translation3::identity(), turn)
-        * Isometry3::from_parts(toe.inverse(), UnitQuaternion::identity())
+    Isometry3::rotation_wrt_point(turn, Point3::new(sole.length / 2.0, 0.0, 0.0))
 }
 
 /// The fastest a leg joint may turn for the heel to rise, relative to the slowest leg joint's
