@@ -318,6 +318,7 @@ impl RunResult {
             "steps": self.steps.steps,
             "planned_steps": self.steps.planned_steps,
             "time_per_step_s": self.steps.time_per_step_s,
+            "time_per_stair_s": self.steps.time_per_stair_s,
             "terrain_collisions": self.steps.terrain_collisions,
             "foothold_error_m": self.steps.foothold_error_m,
             "edge_clearance_m": self.steps.edge_clearance_m,
@@ -772,6 +773,9 @@ fn describe_steps(steps: &StepReport) -> String {
     let mut out = format!("steps {}/{}", steps.steps, steps.planned_steps);
     if let Some(t) = steps.time_per_step_s {
         let _ = write!(out, " ({t:.2} s each)");
+    }
+    if let Some(t) = steps.time_per_stair_s {
+        let _ = write!(out, " {t:.2} s per stair");
     }
     let _ = match steps.foothold_error_m {
         Some(error) => write!(out, " foothold error {error:.3} m"),

@@ -207,6 +207,34 @@ pub(crate) fn elevation_m(state: &SimTruth) -> f64 {
     (state.left_foot[2] + state.right_foot[2]) / 2.0
 }
 
+/// Two sole heights within this (m) are on one level: soles at rest on a tread lie within
+/// millimetres of each other, and a riser is 0.10 m or more.
+const LEVEL_TOLERANCE_M: f64 = 0.02;
+
+/// The time per stair of a walk over stairs from its swings (s): the levels its soles come to
+/// rest on are taken in the order first reached, after `start_z`, the level it starts on; the
+/// time from the first touchdown on the first new level (the first stair) to the first on the
+/// last, over the stairs between. One foot per stair, a stair a step; both feet on each, a
+/// stair two steps. `None` on fewer than two new levels.
+pub(crate) fn time_per_stair_s(swings: &[Swing], start_z: f64) -> Option<f64> {
+    let mut touchdowns: Vec<Touchdown> = swings.iter().filter_map(|s| s.touchdown).collect();
+    touchdowns.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    let mut levels = vec![start_z];
+    let mut reached = Vec::new();
+    for touchdown in touchdowns {
+        let z = touchdown.position[2];
+        if levels
+            .iter()
+            .all(|level| (z - level).abs() > LEVEL_TOLERANCE_M)
+        {
+            levels.push(z);
+            reached.push(touchdown.time_s);
+        }
+    }
+    let (first, last) = (reached.first()?, reached.last()?);
+    (reached.len() >= 2).then(|| (last - first) / (reached.len() - 1) as f64)
+}
+
 /// What the simulator's truth says about the steps of one walk.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct StepReport {
@@ -221,6 +249,9 @@ pub struct StepReport {
     /// Simulated time from the first lift-off to the walk's end over `steps` (s); `None`
     /// without a step.
     pub time_per_step_s: Option<f64>,
+    /// On stairs, the simulated time per stair climbed or descended ([`time_per_stair_s`], s);
+    /// `None` off stairs (a scene without edges) or over fewer than two stairs.
+    pub time_per_stair_s: Option<f64>,
     /// Leg-terrain collisions in the last state (the whole life of that simulator).
     pub terrain_collisions: u64,
     /// The largest horizontal distance of a touchdown from the nearest planned foothold of the
@@ -258,6 +289,11 @@ impl StepReport {
             time_per_step_s: walking_s
                 .filter(|&t| t > 0.0 && steps > 0)
                 .map(|t| t / steps as f64),
+            time_per_stair_s: if edges.is_empty() {
+                None
+            } else {
+                time_per_stair_s(&swings, elevation_m(start))
+            },
             terrain_collisions: end.terrain_collisions,
             foothold_error_m: foothold_error_m(&swings, planned),
             edge_clearance_m: edge_clearance_m(walk, &swings, edges, sole),
@@ -515,7 +551,49 @@ mod tests {
         assert!((per_step - 1.25).abs() < DT, "{per_step}");
         assert_eq!(report.terrain_collisions, 3);
         assert!((report.foothold_error_m.unwrap() - 0.06).abs() < 1e-9);
+        // One stair: no time per stair.
+        assert_eq!(report.time_per_stair_s, None);
         assert_eq!(StepReport::of(&[], 0, 1.0, &planned, (&[], &SOLE)), None);
+    }
+
+    /// Swings landing at `(time, height)` in turn, feet alternating.
+    fn landings(at: &[(f64, f64)]) -> Vec<Swing> {
+        at.iter()
+            .enumerate()
+            .map(|(k, &(time_s, z))| Swing {
+                foot: k % 2,
+                lift_s: time_s - 0.5,
+                touchdown: Some(Touchdown {
+                    time_s,
+                    position: [0.3 * k as f64, 0.0, z],
+                }),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_time_per_stair_counts_levels_not_steps() {
+        // One foot per stair: a stair a step, 1 s apart (a few millimetres of settling on
+        // each tread are one level).
+        let one = landings(&[(1.0, 0.1), (2.0, 0.203), (3.0, 0.3), (4.0, 0.398)]);
+        assert!((time_per_stair_s(&one, 0.0).unwrap() - 1.0).abs() < 1e-12);
+        // Both feet on each stair: the second foot's touchdown on a tread is no new level.
+        let both = landings(&[(1.0, 0.1), (2.0, 0.1), (3.0, 0.2), (4.0, 0.2), (5.0, 0.3)]);
+        assert!((time_per_stair_s(&both, 0.0).unwrap() - 2.0).abs() < 1e-12);
+        // Down from a landing at 0.3 m, unordered swings taken in order of touchdown.
+        let mut down = landings(&[(1.5, 0.2), (3.0, 0.1), (4.5, 0.0)]);
+        down.reverse();
+        assert!((time_per_stair_s(&down, 0.3).unwrap() - 1.5).abs() < 1e-12);
+        // One stair, the flat floor, nothing landed: no time per stair.
+        assert_eq!(
+            time_per_stair_s(&landings(&[(1.0, 0.1), (2.0, 0.1)]), 0.0),
+            None
+        );
+        assert_eq!(
+            time_per_stair_s(&landings(&[(1.0, 0.0), (2.0, 0.0)]), 0.0),
+            None
+        );
+        assert_eq!(time_per_stair_s(&[], 0.0), None);
     }
 
     #[test]
@@ -537,6 +615,7 @@ mod tests {
             steps: 2,
             planned_steps: 2,
             time_per_step_s: Some(1.0),
+            time_per_stair_s: None,
             terrain_collisions: 0,
             foothold_error_m: error,
             edge_clearance_m: None,
