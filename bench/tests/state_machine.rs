@@ -596,8 +596,10 @@ fn the_estimate_turns_onto_the_imu_heading_no_faster_than_its_bound() {
 /// `[controller]` for the static gait, of `[gait.dynamic]` for the dynamic one) is refused
 /// before anything moves, naming the stance, the foot, the height and the key. JVRC-1's dynamic
 /// gait climbs 0.15 m stairs (on its toes) and walks down 0.15 m ones under MuJoCo; up and down
-/// 0.185 m it tipped at the first stair and fell after the fault. Its static gait takes the 10°
-/// ramp's steps, not a 0.10 m stair.
+/// 0.185 m it tipped at the first stair and fell after the fault. A step's height is the riser,
+/// the landing above or below the other foot: one foot per 0.10 m stair, each foot rises 0.20 m
+/// from its last sole, and is taken. Its static gait takes the 10° ramp's steps, not a 0.10 m
+/// stair.
 #[test]
 fn stairs_higher_than_a_gait_takes_are_refused_naming_the_step_and_the_key() {
     use stance::{AffordanceSet, Gait, PostProcessParams, Scene, WalkRequest};
@@ -625,6 +627,8 @@ fn stairs_higher_than_a_gait_takes_are_refused_naming_the_step_and_the_key() {
             .map_err(|refusal| refusal.to_string())
     };
     assert_eq!(prepare("stairs-up-15cm.toml", Gait::Dynamic), Ok(()));
+    assert_eq!(prepare("stairs-up-10cm.toml", Gait::Dynamic), Ok(()));
+    assert_eq!(prepare("stairs-down-10cm.toml", Gait::Dynamic), Ok(()));
     assert_eq!(prepare("stairs-down-15cm.toml", Gait::Dynamic), Ok(()));
     assert_eq!(prepare("ramp-10deg.toml", Gait::Static), Ok(()));
     for (scene, gait, step, key) in [

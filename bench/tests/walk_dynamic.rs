@@ -395,7 +395,7 @@ fn a_paced_learned_walk_is_planned_from_its_stance_durations() {
 
 /// The kinematic simulator stands the feet on the surfaces a sequence was post-processed on
 /// (`sim_adapter::SceneGround`): JVRC-1's dynamic gait climbs the ten 0.10 m stairs of
-/// `stairs-up-10cm.toml` to its top landing, both feet on every stair, its CoM ending 1 m higher
+/// `stairs-up-10cm.toml` to its top landing, one foot per stair, its CoM ending 1 m higher
 /// than it started. On the flat plane of before, the walk fell at the first stair (its feet
 /// planned onto treads the simulator did not have).
 #[test]

@@ -48,6 +48,9 @@ pub struct ParamOverrides {
     /// How much a step's rise or drop counts against s_max on terrain (>= 1).
     #[arg(long)]
     pub rise_weight: Option<f64>,
+    /// The longest step from a stair tread to the next but one [m]: one foot per stair within it.
+    #[arg(long)]
+    pub stair_s_max: Option<f64>,
     /// Pass 2 variant: `first` (the paper's) or `mean`.
     #[arg(long, value_parser = parse_unification)]
     pub contact_unification: Option<ContactUnification>,
@@ -84,6 +87,9 @@ impl ParamOverrides {
             if let Some(value) = value {
                 *field = value;
             }
+        }
+        if let Some(limit) = self.stair_s_max {
+            p.stair_s_max = Some(limit);
         }
         if let Some(mode) = self.contact_unification {
             p.contact_unification = mode;

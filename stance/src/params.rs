@@ -164,6 +164,13 @@ pub struct PostProcessParams {
     /// (docs/scenes.md, "Step length up and down").
     #[serde(default = "PostProcessParams::default_rise_weight")]
     pub rise_weight: f64,
+    /// The longest step, in space, from one stair tread to the next but one (two risers up or
+    /// down): where the treads keep a foot's steps within it, one foot per stair, as people
+    /// climb; both feet on each stair otherwise. Absent: a stair is stepped over only within
+    /// `s_max` (with `rise_weight`), which on 0.30 m treads means both feet on each stair
+    /// (docs/scenes.md, "One foot per stair").
+    #[serde(default)]
+    pub stair_s_max: Option<f64>,
     /// Pass 2 variant; `first` unless the config says `contact_unification = "mean"`.
     #[serde(default)]
     pub contact_unification: ContactUnification,
@@ -323,7 +330,7 @@ impl PostProcessParams {
 
     /// The section's table: every numeric key, its value and its range, one line a key.
     pub fn bounds(&self) -> Vec<Bound> {
-        vec![
+        let mut bounds = vec![
             Bound::new("scf", self.scf, 0.01, 1.0),
             Bound::new("s_max", self.s_max, 0.01, 2.0),
             Bound::new("o_min", self.o_min, 0.0, 1.0),
@@ -335,7 +342,12 @@ impl PostProcessParams {
             Bound::new("h_min", self.h_min, 0.0, 0.5),
             Bound::new("h_max", self.h_max, 0.0, 0.5),
             Bound::new("rise_weight", self.rise_weight, 1.0, 10.0),
-        ]
+        ];
+        bounds.extend(
+            self.stair_s_max
+                .map(|limit| Bound::new("stair_s_max", limit, 0.01, 2.0)),
+        );
+        bounds
     }
 
     /// The swing-foot rotation limits `[α_x, α_y, α_z]`.

@@ -33,7 +33,8 @@
 //!   `zmp_margin_m`]; if that is not enough, T shrinks (single and double support alike, by the
 //!   factor k, not below [`MIN_PERIOD_FRACTION`] of the Froude value) and the dynamic step with it
 //!   (the walking speed stays the Froude speed);
-//! - `[controller]`: JVRC-1's values but `max_step_m` = max(0.5 m·r, dynamic s_max + 0.02 m),
+//! - `[controller]`: JVRC-1's values but `max_step_m` = max(0.5 m·r, dynamic s_max + 0.02 m,
+//!   `stair_s_max` = 0.65 / 0.48 × dynamic s_max),
 //!   `lift_height_m`, `approach_height_m` ·r and `com_speed`, `swing_speed`, `lower_speed` ·t;
 //!   `torso_gain` at most the slowest torso joint's commanded speed limit over
 //!   [`TORSO_SATURATION_RAD`] (ARMAR-4's 0.4 rad/s torso pitch); roll-limited, ARMAR-4's bounds
@@ -327,7 +328,11 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
         reference::dynamic::SCF * s_max_dynamic / reference::dynamic::S_MAX * pelvis,
         0.01,
     );
-    let max_step = round((0.5 * r).max(s_max_dynamic + 0.02), 0.001);
+    let stair_s_max = round(
+        reference::dynamic::STAIR_S_MAX * s_max_dynamic / reference::dynamic::S_MAX,
+        0.001,
+    );
+    let max_step = round((0.5 * r).max(s_max_dynamic + 0.02).max(stair_s_max), 0.001);
 
     let postprocess = vec![
         comment(
@@ -397,6 +402,16 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
         "rise_weight",
         reference::dynamic::RISE_WEIGHT,
         "JVRC-1's: shorter steps up and down stairs",
+    ));
+    dynamic.push(key(
+        "stair_s_max",
+        stair_s_max,
+        format!(
+            "{} × s_max / {}: one foot per stair where two treads are a step this long (JVRC-1's \
+             ratio, measured on its 0.10 m stairs)",
+            reference::dynamic::STAIR_S_MAX,
+            reference::dynamic::S_MAX
+        ),
     ));
 
     let roll_limited = lateral.roll.is_some_and(|c| c.limited);
@@ -717,8 +732,8 @@ fn controller(Scales { r, t }: Scales, rules: ControllerRules) -> Vec<Line> {
                 name,
                 max_step,
                 format!(
-                    "max(0.5 m × l/l_ref, dynamic s_max {s_max_dynamic:.3} + 0.02 m): longer \
-                     steps are refused"
+                    "max(0.5 m × l/l_ref, dynamic s_max {s_max_dynamic:.3} + 0.02 m, \
+                     stair_s_max): longer steps are refused"
                 ),
             ),
             "lift_height_m"
@@ -968,7 +983,7 @@ mod tests {
         );
         assert_eq!(
             (s.o, s.zmp_inward_offset_m, s.max_step_m),
-            ((0.15, 0.24), 0.0, 0.5)
+            ((0.15, 0.24), 0.0, 0.65)
         );
         assert!(!s.roll.unwrap().limited);
     }

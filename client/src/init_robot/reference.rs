@@ -77,7 +77,7 @@ pub const CONTROLLER: [(&str, Tuned); 44] = [
     ("touchdown_force_fraction", Tuned::Number(0.1)),
     ("touchdown_debounce_ticks", Tuned::Integer(3)),
     ("phase_timeout_s", Tuned::Number(5.0)),
-    ("max_step_m", Tuned::Number(0.5)),
+    ("max_step_m", Tuned::Number(0.65)),
     ("max_step_up_m", Tuned::Number(0.06)),
     ("max_step_down_m", Tuned::Number(0.06)),
     ("command_lead_max_rad", Tuned::Number(0.05)),
@@ -156,6 +156,8 @@ pub mod dynamic {
     pub const ALPHA_Y: f64 = 0.05;
     /// `rise_weight`.
     pub const RISE_WEIGHT: f64 = 3.5;
+    /// `stair_s_max` (m).
+    pub const STAIR_S_MAX: f64 = 0.65;
 }
 
 /// ARMAR-4's hand-tuned values (`configs/armar4.toml`) that calibrate the rules for a robot

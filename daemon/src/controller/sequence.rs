@@ -15,10 +15,11 @@ const LIMIT_TOLERANCE: f64 = 1e-6;
 /// of exactly the limit passes, whatever the round-off of the soles' placement.
 const HEIGHT_TOLERANCE_M: f64 = 1e-4;
 
-/// The highest step up and down (m) one foot may take between consecutive contacts in a gait,
-/// and the config section that sets them (named in a refusal). A stair or ramp step a robot's
-/// legs cannot take tips it over at the first stair, after which a held robot falls (JVRC-1's
-/// dynamic gait up 0.15 m stairs and down 0.185 m ones, MuJoCo): refused before anything moves.
+/// The highest step up and down (m) a foot may land above or below the other foot's sole (a
+/// stair's riser) in a gait, and the config section that sets them (named in a refusal). A
+/// stair or ramp step a robot's legs cannot take tips it over at the first stair, after which a
+/// held robot falls (JVRC-1's dynamic gait up and down 0.185 m stairs, MuJoCo): refused before
+/// anything moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepHeights {
     /// Highest step up (m).
@@ -222,13 +223,16 @@ fn check_workspace(stances: &[PreparedStance], config: &ControllerConfig) -> Res
 }
 
 /// Refuses steps (between consecutive contact poses of one foot) longer than `max_step`, or
-/// rising or falling more than `heights` allows.
+/// landing higher or lower than `heights` allows above or below the sole of the other foot,
+/// the one the robot stands on while this one swings: the step a stair's riser makes, whether
+/// the feet go one per stair (a foot then travels two risers) or both on each.
 fn check_steps(
     stances: &[PreparedStance],
     max_step: f64,
     heights: &StepHeights,
 ) -> Result<(), Refusal> {
-    for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
+    use EndEffector::{LeftFoot, RightFoot};
+    for (foot, other) in [(LeftFoot, RightFoot), (RightFoot, LeftFoot)] {
         let mut last_contact: Option<(usize, Isometry3<f64>)> = None;
         for (i, stance) in stances.iter().enumerate() {
             if !stance.contacts[foot as usize] {
@@ -244,16 +248,25 @@ fn check_steps(
                         foot.name()
                     )));
                 }
-                let (way, height, limit) = if step.z >= 0.0 {
-                    ("up", step.z, heights.up)
+                // The stance before the landing: the swing's last, in which the other foot
+                // stands (a foot that lands without swinging is measured from its own sole).
+                let standing = &stances[i - 1];
+                let support = if i > previous + 1 && standing.contacts[other as usize] {
+                    standing.targets[other as usize]
                 } else {
-                    ("down", -step.z, heights.down)
+                    previous_pose
+                };
+                let rise = pose.translation.z - support.translation.z;
+                let (way, height, limit) = if rise >= 0.0 {
+                    ("up", rise, heights.up)
+                } else {
+                    ("down", -rise, heights.down)
                 };
                 if height > limit + HEIGHT_TOLERANCE_M {
                     return Err(Refusal(format!(
-                        "stance {i}: {} steps {way} {height:.3} m from stance {previous}, more than \
-                         {} max_step_{way}_m = {limit}, the highest step this gait is set to take \
-                         (docs/scenes.md, \"Step heights\")",
+                        "stance {i}: {} steps {way} {height:.3} m from the other foot's sole, more \
+                         than {} max_step_{way}_m = {limit}, the highest step this gait is set to \
+                         take (docs/scenes.md, \"Step heights\")",
                         foot.name(),
                         heights.section
                     )));

@@ -207,7 +207,7 @@ pub fn run_passes_observed(
     after(Pass::LimitToMaxStepSize, poses);
     limit_orthogonal_feet_distance(poses, &path, params.o_min, params.o_max);
     after(Pass::LimitOrthogonalFeetDistance, poses);
-    place_on_terrain(poses, environment, sole, params.s_max, params.rise_weight);
+    place_on_terrain(poses, environment, sole, params);
     after(Pass::PlaceOnTerrain, poses);
     hold_hand_affordances(poses, environment, contact.palm_radius);
     after(Pass::HoldHandAffordances, poses);
@@ -296,14 +296,14 @@ pub(crate) mod fixtures {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::fixtures::{BOTH, CONTACT, block, rotated, stance, walk};
     use super::*;
     use crate::geometry::roll_pitch_yaw;
     use crate::params::ContactUnification;
     use kinematics::robot::EndEffector::{LeftFoot, RightFoot};
 
-    fn params() -> PostProcessParams {
+    pub(crate) fn params() -> PostProcessParams {
         PostProcessParams {
             scf: 0.5,
             s_max: 0.3,
@@ -315,6 +315,7 @@ mod tests {
             h_min: 0.03,
             h_max: 0.1,
             rise_weight: 1.0,
+            stair_s_max: None,
             contact_unification: ContactUnification::First,
             gait: crate::Gait::Static,
         }

@@ -16,6 +16,7 @@ use super::path_of;
 use crate::derived::swing_reference;
 use crate::environment::Environment;
 use crate::geometry::PathFrame;
+use crate::params::PostProcessParams;
 use crate::poses::{FEET, HANDS, PoseSequence};
 
 /// Room (m) left between a foothold's heel and the back edge of its surface: the edge the
@@ -82,8 +83,7 @@ pub fn place_on_terrain(
     poses: &mut PoseSequence,
     environment: &Environment,
     sole: &SoleRectangle,
-    s_max: f64,
-    rise_weight: f64,
+    params: &PostProcessParams,
 ) {
     if environment.is_flat_ground() {
         return;
@@ -97,8 +97,9 @@ pub fn place_on_terrain(
             environment,
             path,
             sole,
-            s_max,
-            rise_weight,
+            s_max: params.s_max,
+            rise_weight: params.rise_weight,
+            stair_s_max: params.stair_s_max,
             surface: [None; 2],
             along: [None; 2],
         },
@@ -149,6 +150,8 @@ struct Footholds<'a> {
     s_max: f64,
     /// How much a step's rise or drop counts against `s_max` (`[postprocess] rise_weight`).
     rise_weight: f64,
+    /// The step limit from a tread to the next but one (`[postprocess] stair_s_max`), if set.
+    stair_s_max: Option<f64>,
     /// Index of the surface each foot last landed on.
     surface: [Option<usize>; 2],
     /// Along-path position of each foot's last landing.
@@ -237,7 +240,16 @@ impl Footholds<'_> {
     ) -> bool {
         self.surface[f] != Some(other.surface)
             && self.along[f].is_some()
-            && self.fit(next.surface, along, sole) > self.farthest(f, next.surface, lateral)
+            && self.fit(next.surface, along, sole) > self.farthest_over_a_stair(f, next, lateral)
+    }
+
+    /// The farthest landing of foot `f` on `next`, the tread after the one the other foot
+    /// stands on: within `stair_s_max` in space where it is set, else within `s_max` as any step.
+    fn farthest_over_a_stair(&self, f: usize, next: &Extent, lateral: f64) -> f64 {
+        match self.stair_s_max {
+            Some(limit) => self.reach(f, next.surface, lateral, limit, 1.0),
+            None => self.farthest(f, next.surface, lateral),
+        }
     }
 
     /// The farthest along-path landing of foot `f` on surface `k` (on the line `lateral`) that
@@ -247,6 +259,12 @@ impl Footholds<'_> {
     /// weighted by `w` leaves `√(s_max² − (w h)²)` (JVRC-1's dynamic 3.5: 0.33 m up a 0.10 m
     /// stair).
     fn farthest(&self, f: usize, k: usize, lateral: f64) -> f64 {
+        self.reach(f, k, lateral, self.s_max, self.rise_weight)
+    }
+
+    /// The farthest along-path landing of foot `f` on surface `k` (on the line `lateral`) whose
+    /// step is at most `limit` long, its rise counted `weight` times.
+    fn reach(&self, f: usize, k: usize, lateral: f64, limit: f64, weight: f64) -> f64 {
         let (Some(from), Some(at)) = (self.along[f], self.surface[f]) else {
             return f64::INFINITY;
         };
@@ -254,12 +272,8 @@ impl Footholds<'_> {
             let point = self.path.point(along, lateral);
             self.environment.surfaces[k].plane_elevation_at(point.x, point.y)
         };
-        let reach = |rise: f64| {
-            (self.s_max.powi(2) - (self.rise_weight * rise).powi(2))
-                .max(0.0)
-                .sqrt()
-        };
-        let flat = from + self.s_max;
+        let reach = |rise: f64| (limit.powi(2) - (weight * rise).powi(2)).max(0.0).sqrt();
+        let flat = from + limit;
         match (elevation(at, from), elevation(k, flat)) {
             (Some(start), Some(end)) => from + reach(end - start),
             _ => flat,
@@ -519,6 +533,16 @@ mod tests {
     /// two 0.12 m steps.
     const SHORT_STEPS: [[f64; 2]; 4] = [[0.0, 0.0], [0.0, 0.0], [0.12, 0.0], [0.24, 0.0]];
 
+    /// The terrain pass with step limit `s_max` and `rise_weight`, no stair limit.
+    fn place(poses: &mut PoseSequence, environment: &Environment, s_max: f64, rise_weight: f64) {
+        let params = PostProcessParams {
+            s_max,
+            rise_weight,
+            ..crate::passes::tests::params()
+        };
+        place_on_terrain(poses, environment, &SOLE, &params);
+    }
+
     fn assert_footholds(poses: &PoseSequence, expected: &[[f64; 2]]) {
         let found = footholds(poses);
         assert_eq!(found.len(), expected.len(), "{found:?}");
@@ -537,21 +561,21 @@ mod tests {
         rotated(&mut p, 4, LeftFoot, [0.0, 0.0, 0.2]);
         p.contacts[2][RightHand as usize] = true;
         let before = p.clone();
-        place_on_terrain(&mut p, &Environment::default(), &SOLE, ONE_FOOT, 1.0);
+        place(&mut p, &Environment::default(), ONE_FOOT, 1.0);
         assert_eq!(p, before);
         // Not by the early return alone: a floor at z = 0 with room around the walk.
         let floor = Environment {
             surfaces: vec![block("floor", -1.0, 3.0, 0.0)],
             hand_affordances: Vec::new(),
         };
-        place_on_terrain(&mut p, &floor, &SOLE, ONE_FOOT, 1.0);
+        place(&mut p, &floor, ONE_FOOT, 1.0);
         assert_eq!(p, before);
     }
 
     #[test]
     fn stairs_take_one_foot_per_tread_with_the_toes_clear_of_the_risers() {
         let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
+        place(&mut p, &stairs(), ONE_FOOT, 1.0);
         // Floor: its fit interval ends 0.03 + 0.1 before the riser at 0.5 (0.4 → 0.37). Each
         // tread's interval is [from + 0.15, to − 0.13], and a foot goes to its middle: a
         // landing on the tread the other foot stands on goes on to the next one.
@@ -578,7 +602,7 @@ mod tests {
     #[test]
     fn a_step_limit_shorter_than_two_treads_puts_both_feet_on_each_stair() {
         let mut p = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, 0.4, 1.0);
+        place(&mut p, &stairs(), 0.4, 1.0);
         // The right foot, 0.46 m from tread-1's middle (0.66), first comes up to the floor's
         // edge (0.37) beside the left; the left goes up to tread-1 (0.29 m); the right, 0.59 m
         // on to tread-2 with one foot per stair, joins it on tread-1 instead, beside it, not
@@ -594,9 +618,38 @@ mod tests {
     }
 
     #[test]
+    fn a_stair_limit_puts_one_foot_per_stair_where_s_max_would_put_both() {
+        let limits = |stair_s_max| PostProcessParams {
+            s_max: 0.4,
+            stair_s_max,
+            ..crate::passes::tests::params()
+        };
+        let flat = flat_walk(&[0.2, 0.4, 0.55, 0.7, 0.85, 1.0, 1.15]);
+        let mut p = flat.clone();
+        place_on_terrain(&mut p, &stairs(), &SOLE, &limits(Some(0.64)));
+        // The right foot comes up to the floor's edge first (0.46 m onto tread-1 is a step
+        // beyond s_max, not over a stair), the left goes up to tread-1, and from then on each
+        // foot goes two treads, 0.59–0.60 m along and 0.2 m up (0.623–0.632 m in space).
+        let up = [
+            [0.37, 0.0],
+            [0.66, 0.1],
+            [0.96, 0.2],
+            [1.26, 0.3],
+            [1.55, 0.4],
+        ];
+        assert_footholds(&p, &[&TO_THE_FLOOR_EDGE[..], &up].concat());
+        // Below the step in space: both feet on each stair, as without a stair limit.
+        let mut both = flat.clone();
+        place(&mut both, &stairs(), 0.4, 1.0);
+        let mut p = flat;
+        place_on_terrain(&mut p, &stairs(), &SOLE, &limits(Some(0.62)));
+        assert_eq!(footholds(&p), footholds(&both));
+    }
+
+    #[test]
     fn short_steps_do_not_stall_at_an_edge() {
         let mut p = flat_walk(&[0.12, 0.24, 0.36, 0.48, 0.6, 0.72, 0.84, 0.96]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
+        place(&mut p, &stairs(), ONE_FOOT, 1.0);
         // 0.48 is clamped back to the floor's 0.37, 1 cm of its 12 cm advance on the right foot
         // (0.36): tread-1 instead, then one foot per tread.
         let on = [
@@ -612,7 +665,7 @@ mod tests {
     #[test]
     fn a_foot_comes_up_to_the_edge_before_a_step_onto_a_tread_longer_than_s_max() {
         let mut p = flat_walk(&[0.12, 0.24, 0.4, 0.48, 0.6, 0.72]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, 0.25, 1.0);
+        place(&mut p, &stairs(), 0.25, 1.0);
         // The left foot, stalled at the floor's edge (0.37) beside the right, would go on to
         // tread-1 (0.66), 0.42 m from 0.24: it comes up to the edge instead. The right,
         // already there, goes on (0.29 m, the shortest step onto the tread), and the left
@@ -635,7 +688,7 @@ mod tests {
     #[test]
     fn the_step_limit_holds_in_space_down_a_stair() {
         let mut p = flat_walk(&[0.2, 0.37, 0.9]);
-        place_on_terrain(&mut p, &drop(), &SOLE, 0.48, 1.0);
+        place(&mut p, &drop(), 0.48, 1.0);
         // The right foot's 0.48 m step from 0.2 would be 0.503 m in space: it lands
         // √(0.48² − 0.15²) = 0.456 m along instead, on the floor.
         let found = footholds(&p);
@@ -649,7 +702,7 @@ mod tests {
         // The drop above with the rise weighted 1.5: the right foot's step from 0.3 reaches
         // √(0.48² − (1.5 · 0.15)²) = 0.424 m along instead of 0.456 m.
         let mut p = flat_walk(&[0.3, 0.37, 0.9]);
-        place_on_terrain(&mut p, &drop(), &SOLE, 0.48, 1.5);
+        place(&mut p, &drop(), 0.48, 1.5);
         let found = footholds(&p);
         let [x, z] = found[found.len() - 1];
         let along = (0.48f64.powi(2) - (1.5f64 * 0.15).powi(2)).sqrt();
@@ -671,7 +724,7 @@ mod tests {
     #[test]
     fn a_landing_its_surface_takes_past_s_max_comes_up_to_the_edge_first() {
         let mut p = flat_walk(&[0.2, 0.4, 0.6, 0.75, 1.05]);
-        place_on_terrain(&mut p, &platform(), &SOLE, 0.48, 1.0);
+        place(&mut p, &platform(), 0.48, 1.0);
         // The right foot's landing at 1.05 is on the platform, whose fit interval starts 0.55 m
         // from the foot's 0.6: it comes up to the floor's edge instead.
         let found = footholds(&p);
@@ -691,7 +744,7 @@ mod tests {
             hand_affordances: Vec::new(),
         };
         let mut p = flat_walk(&[0.2, 0.4, 0.6, 0.75, 1.05]);
-        place_on_terrain(&mut p, &riser, &SOLE, 0.48, 3.5);
+        place(&mut p, &riser, 0.48, 3.5);
         let found = footholds(&p);
         assert_eq!(found[found.len() - 1], [0.87, 0.0], "{found:?}");
     }
@@ -699,7 +752,7 @@ mod tests {
     #[test]
     fn a_stalled_landing_goes_on_to_a_long_surface_only_within_s_max() {
         let mut p = flat_walk(&[0.1, 0.2, 0.35, 0.55, 0.8, 1.0]);
-        place_on_terrain(&mut p, &platform(), &SOLE, 0.48, 1.0);
+        place(&mut p, &platform(), 0.48, 1.0);
         // The left foot's landing at 1.0 is clamped back to 0.87, stalled beside the right
         // foot (0.8): on to the platform would be 0.60 m from 0.55, so it comes up to the edge.
         let found = footholds(&p);
@@ -709,7 +762,7 @@ mod tests {
     #[test]
     fn a_long_step_does_not_skip_a_tread() {
         let mut p = flat_walk(&[0.2, 0.3, 1.0]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
+        place(&mut p, &stairs(), ONE_FOOT, 1.0);
         // The right foot would land on tread-2 while the left stands on the floor: tread-1, in
         // the middle of its fit interval.
         let right = p.pose(p.len() - 1, RightFoot).translation.vector;
@@ -726,7 +779,7 @@ mod tests {
             contacts[RightHand as usize] = true;
         }
         let before = p.clone();
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
+        place(&mut p, &stairs(), ONE_FOOT, 1.0);
         let rise =
             |i: usize, e: EndEffector| p.pose(i, e).translation.z - before.pose(i, e).translation.z;
         // Stance 4: both feet on the floor; 6: the left foot on tread-1 (0.1), the right on the
@@ -757,7 +810,7 @@ mod tests {
             stance([-0.05, 0.1, 0.0], [-0.05, -0.1, 0.0], BOTH),
             stance([-0.05, 0.1, 0.0], [0.2, -0.1, 0.0], BOTH),
         ]);
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
+        place(&mut p, &stairs(), ONE_FOOT, 1.0);
         let (left, right) = (p.pose(0, LeftFoot), p.pose(0, RightFoot));
         let middle = (left.translation.vector + right.translation.vector) / 2.0;
         assert!(middle.xy().norm() < 1e-12, "{middle}");
@@ -785,7 +838,7 @@ mod tests {
             stance([0.3, 0.1, 0.0], [0.3, -0.1, 0.0], BOTH),
         ]);
         rotated(&mut p, 1, LeftFoot, [0.0, 0.0, 0.1]);
-        place_on_terrain(&mut p, &env, &SOLE, ONE_FOOT, 1.0);
+        place(&mut p, &env, ONE_FOOT, 1.0);
         let left = p.pose(1, LeftFoot);
         assert!((left.translation.z - 0.3 * slope.tan()).abs() < 1e-12);
         let normal = env.surfaces[0].pose.rotation * Vector3::z();
@@ -809,7 +862,7 @@ mod tests {
             stance([0.6, 0.1, 0.0], [0.6, -0.1, 0.0], BOTH),
         ]);
         let before = p.clone();
-        place_on_terrain(&mut p, &stairs(), &SOLE, ONE_FOOT, 1.0);
+        place(&mut p, &stairs(), ONE_FOOT, 1.0);
         let rise = |i: usize| p.roots[i].translation.z - before.roots[i].translation.z;
         assert!(rise(0).abs() < 1e-12 && (rise(2) - 0.1).abs() < 1e-12);
         assert!((rise(1) - 0.05).abs() < 1e-12, "{}", rise(1));

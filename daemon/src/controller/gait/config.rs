@@ -152,9 +152,11 @@ pub const STEP_DOUBLE_SUPPORT_FACTOR: f64 = 3.2;
 
 /// A stair climbed's single support, relative to a flat step's, unless configured: with its
 /// trailing heel rising first (toe-off) the climb needs less time than a descent, whose stance
-/// knee lowers the whole weight. JVRC-1 (0.75 s, with 1.8 × `double_support_s` next to it) climbs
-/// the 0.10 m and 0.15 m stairs 10/10 under MuJoCo; at 0.65 s and 1.4 × 1/10 and 0/10.
-pub const CLIMB_SINGLE_SUPPORT_FACTOR: f64 = 0.75 / 0.55;
+/// knee lowers the whole weight. JVRC-1 (0.9 s, with 1.8 × `double_support_s` next to it) climbs
+/// the 0.10 m stairs one foot per stair and the 0.15 m ones both feet on each 10/10 under
+/// MuJoCo; one foot per stair at 0.75 s 1/10 (both feet on each: 10/10, and at 0.65 s and 1.4 ×
+/// 1/10 and 0/10).
+pub const CLIMB_SINGLE_SUPPORT_FACTOR: f64 = 0.9 / 0.55;
 
 /// A double support next to a stair climbed, relative to a flat step's, unless configured
 /// (see [`CLIMB_SINGLE_SUPPORT_FACTOR`]).
