@@ -52,6 +52,11 @@ pub struct DynamicGaitConfig {
     /// level one), in place of `step_single_support_s` (s); absent:
     /// [`CLIMB_SINGLE_SUPPORT_FACTOR`] × `single_support_s`.
     pub climb_single_support_s: Option<f64>,
+    /// Duration of the single support of a stair climbed past the other foot, one foot per
+    /// stair (from the tread below the standing foot's to the one above it: two risers, two
+    /// treads), in place of `climb_single_support_s` (s); absent:
+    /// [`CLIMB_PAST_SINGLE_SUPPORT_FACTOR`] × `single_support_s`.
+    pub climb_past_single_support_s: Option<f64>,
     /// Duration of a double support next to a stair climbed with no other step up or down on
     /// its other side, in place of `step_double_support_s` (s); absent:
     /// [`CLIMB_DOUBLE_SUPPORT_FACTOR`] × `double_support_s`.
@@ -152,11 +157,15 @@ pub const STEP_DOUBLE_SUPPORT_FACTOR: f64 = 3.2;
 
 /// A stair climbed's single support, relative to a flat step's, unless configured: with its
 /// trailing heel rising first (toe-off) the climb needs less time than a descent, whose stance
-/// knee lowers the whole weight. JVRC-1 (0.9 s, with 1.8 × `double_support_s` next to it) climbs
-/// the 0.10 m stairs one foot per stair and the 0.15 m ones both feet on each 10/10 under
-/// MuJoCo; one foot per stair at 0.75 s 1/10 (both feet on each: 10/10, and at 0.65 s and 1.4 ×
-/// 1/10 and 0/10).
-pub const CLIMB_SINGLE_SUPPORT_FACTOR: f64 = 0.9 / 0.55;
+/// knee lowers the whole weight. JVRC-1 (0.75 s, with 1.8 × `double_support_s` next to it) climbs
+/// the 0.10 m and 0.15 m stairs both feet on each 10/10 under MuJoCo; at 0.65 s and 1.4 × 1/10
+/// and 0/10.
+pub const CLIMB_SINGLE_SUPPORT_FACTOR: f64 = 0.75 / 0.55;
+
+/// A stair climbed past the other foot (one foot per stair), relative to a flat step's single
+/// support, unless configured: the swing goes two treads and two risers. JVRC-1 climbs the 0.10 m
+/// stairs one foot per stair 10/10 at 0.9 s under MuJoCo; at 0.75 s 1/10, at 0.8 s 4/10.
+pub const CLIMB_PAST_SINGLE_SUPPORT_FACTOR: f64 = 0.9 / 0.55;
 
 /// A double support next to a stair climbed, relative to a flat step's, unless configured
 /// (see [`CLIMB_SINGLE_SUPPORT_FACTOR`]).
@@ -185,6 +194,7 @@ impl Default for DynamicGaitConfig {
             double_support_s: 0.25,
             step_double_support_s: None,
             climb_single_support_s: None,
+            climb_past_single_support_s: None,
             climb_double_support_s: None,
             initial_double_support_s: 1.0,
             final_double_support_s: 1.0,
@@ -428,6 +438,13 @@ impl DynamicGaitConfig {
             .unwrap_or(CLIMB_SINGLE_SUPPORT_FACTOR * self.single_support_s)
     }
 
+    /// The single support of a stair climbed past the other foot (`climb_past_single_support_s`
+    /// or its default).
+    pub fn climb_past_single_support(&self) -> f64 {
+        self.climb_past_single_support_s
+            .unwrap_or(CLIMB_PAST_SINGLE_SUPPORT_FACTOR * self.single_support_s)
+    }
+
     /// The double support next to a stair climbed (`climb_double_support_s` or its default).
     pub fn climb_double_support(&self) -> f64 {
         self.climb_double_support_s
@@ -509,6 +526,12 @@ impl DynamicGaitConfig {
             Bound::optional(
                 "climb_single_support_s",
                 self.climb_single_support_s,
+                0.1,
+                5.0,
+            ),
+            Bound::optional(
+                "climb_past_single_support_s",
+                self.climb_past_single_support_s,
                 0.1,
                 5.0,
             ),
@@ -722,6 +745,7 @@ mod tests {
             ("gait.dynamic", "double_support_s"),
             ("gait.dynamic", "step_double_support_s"),
             ("gait.dynamic", "climb_single_support_s"),
+            ("gait.dynamic", "climb_past_single_support_s"),
             ("gait.dynamic", "climb_double_support_s"),
             ("gait.dynamic", "initial_double_support_s"),
             ("gait.dynamic", "final_double_support_s"),

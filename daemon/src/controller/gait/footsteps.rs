@@ -9,8 +9,9 @@
 //!   stair climbed (level soles) with no other step on its other side `climb_double_support_s`;
 //! - a foot added (single → double support): the single-support phase in which it swings, from
 //!   lift-off through the highest post-processed swing pose of its flight to its contact pose;
-//!   it lasts `single_support_s` (a stair climbed: `climb_single_support_s`; any other step
-//!   up or down: `step_single_support_s`);
+//!   it lasts `single_support_s` (a stair climbed: `climb_single_support_s`, past the other
+//!   foot, one foot per stair: `climb_past_single_support_s`; any other step up or down:
+//!   `step_single_support_s`);
 //! - a foot added and the other released at once (single support on one foot, then on the
 //!   other): that swing, then a double support of `double_support_s` before the lift-off;
 //! - only hands change: a double support of `hand_transition_s` while they reach;
@@ -325,19 +326,24 @@ impl Builder<'_> {
         }
     }
 
-    /// The single support of a swing from `lift_off` to `landing`: the stances its foot was in
-    /// the air, if all timed, else `single_support_s`; a stair climbed no shorter than
-    /// `climb_single_support()`, any other step up or down no shorter than
-    /// `step_single_support()`.
+    /// The single support of a swing from `lift_off` to `landing` while the other foot stands
+    /// at `standing`: the stances its foot was in the air, if all timed, else
+    /// `single_support_s`; a stair climbed no shorter than `climb_single_support()` (past the
+    /// standing foot, one foot per stair: `climb_past_single_support()`), any other step up or
+    /// down no shorter than `step_single_support()`.
     fn swing_single_support(
         &mut self,
         lift_off: &Isometry3<f64>,
         landing: &Isometry3<f64>,
+        standing: Option<&Isometry3<f64>>,
     ) -> (f64, PhaseTiming) {
         let limits = self.timing.timed_single_support();
         let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
         let step = match Rise::of(lift_off, landing) {
             Rise::Level => return timed(dwell, self.timing.single_support_s, limits, 0.0),
+            Rise::Stair if standing.is_some_and(|s| climbs_past(lift_off, landing, s)) => {
+                self.timing.climb_past_single_support()
+            }
             Rise::Stair => self.timing.climb_single_support(),
             Rise::Step => self.timing.step_single_support(),
         };
@@ -351,7 +357,8 @@ impl Builder<'_> {
             .take()
             .expect("a foot is added only while it is in the air");
         debug_assert_eq!(swinging, foot);
-        let duration = self.swing_single_support(&lift_off, &landing);
+        let standing = self.feet[1 - slot(foot)];
+        let duration = self.swing_single_support(&lift_off, &landing, standing.as_ref());
         self.push(
             Support::Single(SwingPlan {
                 foot,
@@ -396,7 +403,6 @@ fn timed(dwell: Dwell, configured: f64, [min, max]: [f64; 2], floor: f64) -> (f6
     }
 }
 
-/// Index of a foot in the `[_; 2]` arrays.
 /// How a swing changes height.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Rise {
@@ -428,6 +434,20 @@ impl Rise {
     }
 }
 
+/// Whether a swing from `lift_off` to `landing` climbs past the foot standing at `standing`: it
+/// lifts off more than [`STEP_HEIGHT_M`] below that foot and lands more than that above it, one
+/// foot per stair.
+fn climbs_past(
+    lift_off: &Isometry3<f64>,
+    landing: &Isometry3<f64>,
+    standing: &Isometry3<f64>,
+) -> bool {
+    let height = standing.translation.z;
+    lift_off.translation.z < height - STEP_HEIGHT_M
+        && landing.translation.z > height + STEP_HEIGHT_M
+}
+
+/// Index of a foot in the `[_; 2]` arrays.
 fn slot(foot: EndEffector) -> usize {
     match foot {
         EndEffector::LeftFoot => 0,
@@ -510,6 +530,29 @@ mod tests {
             [timing.climb_single_support(), timing.single_support_s]
         );
         assert!(timing.climb_single_support() > timing.single_support_s);
+    }
+
+    #[test]
+    fn a_stair_climbed_past_the_other_foot_takes_the_climb_past_single_support() {
+        let timing = DynamicGaitConfig::default();
+        // One foot per 0.10 m stair: the left onto the first tread, beside the right on the
+        // floor; then each foot from the tread below the other's to the one above it.
+        let stances = [
+            stance(DS, standing()[0], standing()[1]),
+            stance(LEFT_UP, at(0.15, 0.1, 0.13), standing()[1]),
+            stance(DS, at(0.3, 0.1, 0.1), standing()[1]),
+            stance(RIGHT_UP, at(0.3, 0.1, 0.1), at(0.3, -0.1, 0.23)),
+            stance(DS, at(0.3, 0.1, 0.1), at(0.6, -0.1, 0.2)),
+            stance(LEFT_UP, at(0.6, 0.1, 0.33), at(0.6, -0.1, 0.2)),
+            stance(DS, at(0.9, 0.1, 0.3), at(0.6, -0.1, 0.2)),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        let past = timing.climb_past_single_support();
+        assert_eq!(
+            durations(&plan, true),
+            [timing.climb_single_support(), past, past]
+        );
+        assert!(past > timing.climb_single_support());
     }
 
     #[test]
