@@ -803,9 +803,10 @@ fn controller_heading(key: &str) -> Option<&'static str> {
              more than this (rad)"
         }
         "max_step_up_m" => {
-            "... or with a higher step up or down in the static gait (docs/scenes.md, \"Step \
-             heights\")"
+            "... or landing higher or lower than this above or below the other foot in the static \
+             gait (docs/scenes.md, \"Step heights\")"
         }
+        "max_slope_rad" => "... or with a sole standing on a slope steeper than this (rad)",
         "standing_crouch_max_m" => {
             "with a foot in the air (static gait), take the step back when landing it would need \
              the standing leg to lower the body deeper than this (m)"

@@ -40,7 +40,7 @@ pub enum Tuned {
 }
 
 /// `configs/jvrc1.toml` `[controller]`, in its order.
-pub const CONTROLLER: [(&str, Tuned); 44] = [
+pub const CONTROLLER: [(&str, Tuned); 45] = [
     ("com_weight", Tuned::Number(10.0)),
     ("foot_weight", Tuned::Number(10.0)),
     ("unload_foot_weight", Tuned::Number(10.0)),
@@ -80,6 +80,7 @@ pub const CONTROLLER: [(&str, Tuned); 44] = [
     ("max_step_m", Tuned::Number(0.65)),
     ("max_step_up_m", Tuned::Number(0.06)),
     ("max_step_down_m", Tuned::Number(0.06)),
+    ("max_slope_rad", Tuned::Number(0.18)),
     ("command_lead_max_rad", Tuned::Number(0.05)),
     ("tipping_detection_rad", Tuned::Number(0.25)),
     ("catch_tilt_rad", Tuned::Number(0.1)),
@@ -88,7 +89,7 @@ pub const CONTROLLER: [(&str, Tuned); 44] = [
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic]`, in its order.
-pub const GAIT_DYNAMIC: [(&str, Tuned); 18] = [
+pub const GAIT_DYNAMIC: [(&str, Tuned); 19] = [
     ("single_support_s", Tuned::Number(0.55)),
     ("double_support_s", Tuned::Number(0.25)),
     ("initial_double_support_s", Tuned::Number(1.0)),
@@ -105,6 +106,7 @@ pub const GAIT_DYNAMIC: [(&str, Tuned); 18] = [
     ("torso_posture_weight", Tuned::Number(1.0)),
     ("max_step_up_m", Tuned::Number(0.15)),
     ("max_step_down_m", Tuned::Number(0.15)),
+    ("max_slope_rad", Tuned::Number(0.27)),
     ("toe_off_rad", Tuned::Number(0.5)),
     ("toe_off_s", Tuned::Number(0.3)),
 ];

@@ -9,10 +9,14 @@ use kinematics::{ConfigFile, ConfigFileError};
 use serde::Deserialize;
 
 use super::gait::force_difference_bounds;
-use super::sequence::StepHeights;
+use super::sequence::TerrainLimits;
 
 /// The section [`ControllerConfig`] is read from.
 const SECTION: &str = "controller";
+
+/// `max_slope_rad` of the static gait unless configured: JVRC-1's, which walks the 10° ramp up
+/// and down (0.175 rad, with room for round-off).
+pub const STATIC_MAX_SLOPE_RAD: f64 = 0.18;
 
 /// Controller tuning from the `[controller]` section; every key is optional (defaults below suit
 /// the vendored humanoids) and an unknown key is an error naming the file and key.
@@ -109,13 +113,16 @@ pub struct ControllerConfig {
     pub phase_timeout_s: f64,
     /// Longest step between consecutive contacts of one foot that a sequence may ask for (m).
     pub max_step_m: f64,
-    /// Highest step up between consecutive contacts of one foot the static gait takes (m); a
-    /// sequence with a higher one is refused (docs/scenes.md, "Step heights"). JVRC-1's
+    /// Highest step up the static gait takes: a landing this far above the other foot's sole
+    /// at most (m, the stair's riser); a sequence with a higher one is refused (docs/scenes.md, "Step heights"). JVRC-1's
     /// standing knee lifts it up a 0.10 m stair in 1 of 4 walks and tips it in the others.
     pub max_step_up_m: f64,
     /// Highest step down the static gait takes (m): JVRC-1 cannot reach a 0.10 m stair's tread
     /// 0.29 m ahead with its CoM over the standing foot (its steps are taken back).
     pub max_step_down_m: f64,
+    /// Steepest surface the static gait stands on: a sole in contact tilted more than this from
+    /// horizontal is refused (rad; docs/scenes.md, "Step heights").
+    pub max_slope_rad: f64,
     /// How far the integrated joint command may lead the measured angle (rad). The command is
     /// integrated from the previous command, so a loaded joint keeps the servo offset that holds
     /// its load; this bound stops the integral from winding up when a joint is blocked.
@@ -256,6 +263,7 @@ impl Default for ControllerConfig {
             max_step_m: 0.5,
             max_step_up_m: 0.06,
             max_step_down_m: 0.06,
+            max_slope_rad: STATIC_MAX_SLOPE_RAD,
             command_lead_max_rad: 0.05,
             unload_foot_weight: 100.0,
             tipping_detection_rad: 0.25,
@@ -318,11 +326,12 @@ pub enum ConfigError {
 }
 
 impl ControllerConfig {
-    /// The static gait's step heights (`max_step_up_m`, `max_step_down_m`).
-    pub fn step_heights(&self) -> StepHeights {
-        StepHeights {
+    /// The terrain the static gait takes (`max_step_up_m`, `max_step_down_m`, `max_slope_rad`).
+    pub fn terrain_limits(&self) -> TerrainLimits {
+        TerrainLimits {
             up: self.max_step_up_m,
             down: self.max_step_down_m,
+            slope: self.max_slope_rad,
             section: "[controller]",
         }
     }
@@ -462,6 +471,7 @@ impl ControllerConfig {
             Bound::new("max_step_m", self.max_step_m, 0.01, 2.0),
             Bound::new("max_step_up_m", self.max_step_up_m, 0.0, 1.0),
             Bound::new("max_step_down_m", self.max_step_down_m, 0.0, 1.0),
+            Bound::new("max_slope_rad", self.max_slope_rad, 0.0, 1.0),
             Bound::new("command_lead_max_rad", self.command_lead_max_rad, 1e-4, 1.0),
             Bound::new(
                 "tipping_detection_rad",

@@ -60,7 +60,7 @@ use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
 
 pub use config::{ConfigError, ControllerConfig};
 pub use gait::{DynamicGaitConfig, GaitConfig, StabilizerConfig};
-pub use sequence::{PreparedSequence, Refusal, StepHeights};
+pub use sequence::{PreparedSequence, Refusal, TerrainLimits};
 pub use stance::Gait;
 pub use status::{
     BalanceStatus, ControllerState, ControllerStatus, FaultCode, FaultDescription,
@@ -316,7 +316,7 @@ impl Controller {
         config: &ControllerConfig,
         seq: &stance::PostProcessedSequence,
     ) -> Result<PreparedSequence, Refusal> {
-        PreparedSequence::new(robot, config, &config.step_heights(), seq)
+        PreparedSequence::new(robot, config, &config.terrain_limits(), seq)
     }
 
     /// Non-RT: [`prepare`](Self::prepare) for `gait`; a dynamic walk is also planned here (its
@@ -333,7 +333,7 @@ impl Controller {
             return Self::prepare(robot, config, seq);
         };
         let dynamic = gaits.dynamic().map_err(|e| Refusal(e.to_string()))?;
-        let mut prepared = PreparedSequence::new(robot, config, &dynamic.step_heights(), seq)?;
+        let mut prepared = PreparedSequence::new(robot, config, &dynamic.terrain_limits(), seq)?;
         let plan = DynamicPlan::new(
             robot,
             &prepared.stances,

@@ -2,7 +2,7 @@
 //! controller's limits, converted to the controller's storage off the real-time path.
 
 use kinematics::robot::{EndEffector, Robot};
-use nalgebra::{DVector, Isometry3};
+use nalgebra::{DVector, Isometry3, Vector3};
 
 use super::config::ControllerConfig;
 use super::gait::DynamicPlan;
@@ -15,21 +15,28 @@ const LIMIT_TOLERANCE: f64 = 1e-6;
 /// of exactly the limit passes, whatever the round-off of the soles' placement.
 const HEIGHT_TOLERANCE_M: f64 = 1e-4;
 
-/// The highest step up and down (m) a foot may land above or below the other foot's sole (a
-/// stair's riser) in a gait, and the config section that sets them (named in a refusal). A
-/// stair or ramp step a robot's legs cannot take tips it over at the first stair, after which a
-/// held robot falls (JVRC-1's dynamic gait up and down 0.185 m stairs, MuJoCo): refused before
-/// anything moves.
+/// The terrain a gait is set to take: the highest step up and down (m) a foot may land above or
+/// below the other foot's sole (a stair's riser), the steepest surface (rad) a sole may stand on,
+/// and the config section that sets them (named in a refusal). A stair or ramp a robot's legs
+/// cannot take tips it over at the first stair (JVRC-1's dynamic gait up and down 0.185 m
+/// stairs, MuJoCo) or lets it fall on the slope (ARMAR-4's static gait on the 10° ramp), after
+/// which a held robot falls: refused before anything moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StepHeights {
+pub struct TerrainLimits {
     /// Highest step up (m).
     pub up: f64,
     /// Highest step down (m).
     pub down: f64,
-    /// The section holding `max_step_up_m` and `max_step_down_m` (`[controller]`,
-    /// `[gait.dynamic]`).
+    /// Steepest sole in contact, its tilt from horizontal (rad).
+    pub slope: f64,
+    /// The section holding `max_step_up_m`, `max_step_down_m` and `max_slope_rad`
+    /// (`[controller]`, `[gait.dynamic]`).
     pub section: &'static str,
 }
+
+/// Tolerance on a sole's tilt against `max_slope_rad` (rad): a level tread's sole is level to
+/// round-off, and a ramp of exactly the limit passes.
+const SLOPE_TOLERANCE_RAD: f64 = 1e-4;
 
 /// Why a sequence is refused; the message names the stance and field.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -96,12 +103,12 @@ impl PreparedSequence {
     ///
     /// Refused: another robot or joint order, an empty sequence, a non-finite value, a posture
     /// beyond a joint limit, a stance without foot support, a step between consecutive contacts
-    /// of one foot longer than `config.max_step_m`, or higher up or down than `heights` (the
-    /// gait's).
+    /// of one foot longer than `config.max_step_m`, or higher up or down than `terrain` allows,
+    /// or a sole in contact on a slope steeper than it (the gait's).
     pub fn new(
         robot: &Robot,
         config: &ControllerConfig,
-        heights: &StepHeights,
+        terrain: &TerrainLimits,
         seq: &stance::PostProcessedSequence,
     ) -> Result<Self, Refusal> {
         seq.check_robot(robot)
@@ -159,7 +166,8 @@ impl PreparedSequence {
                 duration_s: seq.stances()[i].duration_s,
             });
         }
-        check_steps(&stances, config.max_step_m, heights)?;
+        check_steps(&stances, config.max_step_m, terrain)?;
+        check_slopes(&stances, terrain)?;
         check_workspace(&stances, config)?;
         Ok(Self {
             stances,
@@ -167,6 +175,32 @@ impl PreparedSequence {
             railings: RailAxis::of_scene(&seq.environment().hand_affordances),
         })
     }
+}
+
+/// Refuses a foot in contact whose sole is tilted from horizontal more than `terrain.slope`: a
+/// surface steeper than the gait is set to stand on.
+fn check_slopes(stances: &[PreparedStance], terrain: &TerrainLimits) -> Result<(), Refusal> {
+    for (i, stance) in stances.iter().enumerate() {
+        for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
+            if !stance.contacts[foot as usize] {
+                continue;
+            }
+            let normal = stance.targets[foot as usize].rotation * Vector3::z();
+            let tilt = normal.angle(&Vector3::z());
+            if tilt > terrain.slope + SLOPE_TOLERANCE_RAD {
+                return Err(Refusal(format!(
+                    "stance {i}: {} stands on a slope of {tilt:.3} rad ({:.1}°), more than {} \
+                     max_slope_rad = {}, the steepest slope this gait is set to stand on \
+                     (docs/scenes.md, \"Step heights\")",
+                    foot.name(),
+                    tilt.to_degrees(),
+                    terrain.section,
+                    terrain.slope
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Refuses targets outside the workspace the config allows: beyond `workspace_radius_m`
@@ -223,13 +257,13 @@ fn check_workspace(stances: &[PreparedStance], config: &ControllerConfig) -> Res
 }
 
 /// Refuses steps (between consecutive contact poses of one foot) longer than `max_step`, or
-/// landing higher or lower than `heights` allows above or below the sole of the other foot,
+/// landing higher or lower than `terrain` allows above or below the sole of the other foot,
 /// the one the robot stands on while this one swings: the step a stair's riser makes, whether
 /// the feet go one per stair (a foot then travels two risers) or both on each.
 fn check_steps(
     stances: &[PreparedStance],
     max_step: f64,
-    heights: &StepHeights,
+    terrain: &TerrainLimits,
 ) -> Result<(), Refusal> {
     use EndEffector::{LeftFoot, RightFoot};
     for (foot, other) in [(LeftFoot, RightFoot), (RightFoot, LeftFoot)] {
@@ -258,9 +292,9 @@ fn check_steps(
                 };
                 let rise = pose.translation.z - support.translation.z;
                 let (way, height, limit) = if rise >= 0.0 {
-                    ("up", rise, heights.up)
+                    ("up", rise, terrain.up)
                 } else {
-                    ("down", -rise, heights.down)
+                    ("down", -rise, terrain.down)
                 };
                 if height > limit + HEIGHT_TOLERANCE_M {
                     return Err(Refusal(format!(
@@ -268,7 +302,7 @@ fn check_steps(
                          than {} max_step_{way}_m = {limit}, the highest step this gait is set to \
                          take (docs/scenes.md, \"Step heights\")",
                         foot.name(),
-                        heights.section
+                        terrain.section
                     )));
                 }
             }

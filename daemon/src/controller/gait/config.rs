@@ -13,7 +13,7 @@ use kinematics::bounds::{Bound, Number, Range};
 use kinematics::config_file::toml_message;
 
 use crate::controller::config::{ConfigError, check};
-use crate::controller::sequence::StepHeights;
+use crate::controller::sequence::TerrainLimits;
 
 /// What a robot config says about gaits. Without a `[gait]` section a robot walks statically
 /// only.
@@ -121,13 +121,18 @@ pub struct DynamicGaitConfig {
     /// the body walked on, the stance sole rolled onto a corner and turned about it, and walks
     /// with a held hand fell. Absent: the `[controller]` value.
     pub torso_posture_weight: Option<f64>,
-    /// Highest step up between consecutive contacts of one foot the dynamic gait takes (m); a
-    /// sequence with a higher one is refused (docs/scenes.md, "Step heights"). With toe-off,
+    /// Highest step up the dynamic gait takes: a landing this far above the other foot's sole
+    /// at most (m, the stair's riser, one foot per stair or both on each); a sequence with a
+    /// higher one is refused (docs/scenes.md, "Step heights"). With toe-off,
     /// JVRC-1 climbs 0.15 m stairs 10/10 under MuJoCo and tips on 0.185 m ones.
     pub max_step_up_m: f64,
     /// Highest step down the dynamic gait takes (m): JVRC-1 walks down 0.15 m stairs 10/10 and
     /// tips at the first 0.185 m one, its trailing knee at its torque limit.
     pub max_step_down_m: f64,
+    /// Steepest surface the dynamic gait stands on: a sole in contact tilted more than this
+    /// from horizontal is refused (rad; docs/scenes.md, "Step heights"). JVRC-1 walks up and down
+    /// the 15° ramp 10/10 under MuJoCo.
+    pub max_slope_rad: f64,
     /// The heel of a foot about to swing up a step rises about its toe by this pitch at the end
     /// of the double support before (rad; 0: the sole stays flat), so the trailing leg reaches
     /// farther (docs/scenes.md, "Toe-off").
@@ -154,6 +159,10 @@ pub const STEP_SINGLE_SUPPORT_FACTOR: f64 = 2.0;
 /// creep (MuJoCo `impratio` 20) the 0.15 m descent's trailing knee saturated lowering the robot
 /// onto the lower stair in 0.55 s, 7/10; with 0.8 s it walks 10/10.
 pub const STEP_DOUBLE_SUPPORT_FACTOR: f64 = 3.2;
+
+/// `max_slope_rad` unless configured: JVRC-1's, which walks the 15° ramp up and down 10/10
+/// under MuJoCo (0.262 rad, with room for round-off).
+pub const DYNAMIC_MAX_SLOPE_RAD: f64 = 0.27;
 
 /// A stair climbed's single support, relative to a flat step's, unless configured: with its
 /// trailing heel rising first (toe-off) the climb needs less time than a descent, whose stance
@@ -214,6 +223,7 @@ impl Default for DynamicGaitConfig {
             torso_posture_weight: Some(1.0),
             max_step_up_m: 0.15,
             max_step_down_m: 0.15,
+            max_slope_rad: DYNAMIC_MAX_SLOPE_RAD,
             toe_off_rad: 0.5,
             toe_off_s: 0.3,
             stabilizer: StabilizerConfig::default(),
@@ -411,11 +421,13 @@ fn deserialize<T: serde::de::DeserializeOwned>(
 }
 
 impl DynamicGaitConfig {
-    /// The dynamic gait's step heights (`max_step_up_m`, `max_step_down_m`).
-    pub fn step_heights(&self) -> StepHeights {
-        StepHeights {
+    /// The terrain the dynamic gait takes (`max_step_up_m`, `max_step_down_m`,
+    /// `max_slope_rad`).
+    pub fn terrain_limits(&self) -> TerrainLimits {
+        TerrainLimits {
             up: self.max_step_up_m,
             down: self.max_step_down_m,
+            slope: self.max_slope_rad,
             section: "[gait.dynamic]",
         }
     }
@@ -572,6 +584,7 @@ impl DynamicGaitConfig {
             Bound::optional("torso_posture_weight", self.torso_posture_weight, 1e-6, 1e6),
             Bound::new("max_step_up_m", self.max_step_up_m, 0.0, 1.0),
             Bound::new("max_step_down_m", self.max_step_down_m, 0.0, 1.0),
+            Bound::new("max_slope_rad", self.max_slope_rad, 0.0, 1.0),
             Bound::new("toe_off_rad", self.toe_off_rad, 0.0, 0.8),
             Bound::new("toe_off_s", self.toe_off_s, 0.01, 5.0),
         ]
