@@ -16,7 +16,7 @@ const SECTION: &str = "controller";
 
 /// `max_slope_rad` of the static gait unless configured: JVRC-1's, which walks the 10° ramp up
 /// and down (0.175 rad, with room for round-off).
-pub const STATIC_MAX_SLOPE_RAD: f64 = 0.18;
+const STATIC_MAX_SLOPE_RAD: f64 = 0.18;
 
 /// Controller tuning from the `[controller]` section; every key is optional (defaults below suit
 /// the vendored humanoids) and an unknown key is an error naming the file and key.
@@ -114,8 +114,9 @@ pub struct ControllerConfig {
     /// Longest step between consecutive contacts of one foot that a sequence may ask for (m).
     pub max_step_m: f64,
     /// Highest step up the static gait takes: a landing this far above the other foot's sole
-    /// at most (m, the stair's riser); a sequence with a higher one is refused (docs/scenes.md, "Step heights"). JVRC-1's
-    /// standing knee lifts it up a 0.10 m stair in 1 of 4 walks and tips it in the others.
+    /// at most (m, the stair's riser); a sequence with a higher one is refused (docs/scenes.md,
+    /// "Step heights"). JVRC-1's standing knee lifts it up a 0.10 m stair in 1 of 4 walks and
+    /// tips it in the others.
     pub max_step_up_m: f64,
     /// Highest step down the static gait takes (m): JVRC-1 cannot reach a 0.10 m stair's tread
     /// 0.29 m ahead with its CoM over the standing foot (its steps are taken back).

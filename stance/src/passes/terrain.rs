@@ -53,7 +53,8 @@ pub const SHORT_SURFACE_SOLES: f64 = 2.0;
 ///    order: (i) no surface is skipped: the foot lands on the other foot's surface or the next
 ///    one forward along the path; (ii) one foot per short surface ([`SHORT_SURFACE_SOLES`]): not
 ///    on the one the other foot stands on, but on the next — unless that step would be longer
-///    than `s_max` and the foot is not on the other's surface yet: then it joins the other foot
+///    than the stair limit (`stair_s_max` in space where set, else `s_max` with
+///    `rise_weight`) and the foot is not on the other's surface yet: then it joins the other foot
 ///    there, both feet on each stair (the lead foot goes up, the other follows onto the same
 ///    tread, as the anchors' controllers climb), each step one tread long; (iii) the sole
 ///    centre is clamped into

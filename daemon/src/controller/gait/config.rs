@@ -162,7 +162,7 @@ pub const STEP_DOUBLE_SUPPORT_FACTOR: f64 = 3.2;
 
 /// `max_slope_rad` unless configured: JVRC-1's, which walks the 15° ramp up and down 10/10
 /// under MuJoCo (0.262 rad, with room for round-off).
-pub const DYNAMIC_MAX_SLOPE_RAD: f64 = 0.27;
+const DYNAMIC_MAX_SLOPE_RAD: f64 = 0.27;
 
 /// A stair climbed's single support, relative to a flat step's, unless configured: with its
 /// trailing heel rising first (toe-off) the climb needs less time than a descent, whose stance
