@@ -250,7 +250,8 @@ pub struct StepReport {
     /// without a step.
     pub time_per_step_s: Option<f64>,
     /// On stairs, the simulated time per stair climbed or descended ([`time_per_stair_s`], s);
-    /// `None` off stairs (a scene without edges) or over fewer than two stairs.
+    /// `None` off stairs (no swing passed over an edge: `edge_clearance_m` is `None`, as on the
+    /// flat floor and the ramps, whose levels are every step's) or over fewer than two stairs.
     pub time_per_stair_s: Option<f64>,
     /// Leg-terrain collisions in the last state (the whole life of that simulator).
     pub terrain_collisions: u64,
@@ -278,6 +279,7 @@ impl StepReport {
         let (start, end) = (walk.first()?, walk.last()?);
         let swings = swings(walk);
         let steps = swings.iter().filter(|s| s.touchdown.is_some()).count();
+        let edge_clearance = edge_clearance_m(walk, &swings, edges, sole);
         let walking_s = swings
             .first()
             .map(|first| walk_s - (first.lift_s - start.sim_time_s));
@@ -289,14 +291,11 @@ impl StepReport {
             time_per_step_s: walking_s
                 .filter(|&t| t > 0.0 && steps > 0)
                 .map(|t| t / steps as f64),
-            time_per_stair_s: if edges.is_empty() {
-                None
-            } else {
-                time_per_stair_s(&swings, elevation_m(start))
-            },
+            time_per_stair_s: edge_clearance
+                .and_then(|_| time_per_stair_s(&swings, elevation_m(start))),
             terrain_collisions: end.terrain_collisions,
             foothold_error_m: foothold_error_m(&swings, planned),
-            edge_clearance_m: edge_clearance_m(walk, &swings, edges, sole),
+            edge_clearance_m: edge_clearance,
         })
     }
 
@@ -594,6 +593,35 @@ mod tests {
             None
         );
         assert_eq!(time_per_stair_s(&[], 0.0), None);
+    }
+
+    #[test]
+    fn the_time_per_stair_needs_a_swing_over_an_edge() {
+        // Two stairs up: the left sole onto a tread 0.185 m up, the right past it 0.37 m up,
+        // touching down (at rest REST_S) about 1.3 s apart.
+        let left = step([0.0, 0.1, 0.0], [0.3, 0.1, 0.185], 0.5, 0.6, 0.03);
+        let right = step([0.0, -0.1, 0.0], [0.6, -0.1, 0.37], 1.8, 0.6, 0.05);
+        let states = walk(4.0, left, right);
+        let tread = |x: f64| Environment {
+            surfaces: vec![SupportSurface {
+                name: "tread".to_owned(),
+                pose: Isometry3::translation(x, 0.0, 0.185),
+                polygon: Some(vec![[-0.15, -0.5], [0.15, -0.5], [0.15, 0.5], [-0.15, 0.5]]),
+            }],
+            hand_affordances: Vec::new(),
+        };
+        let report = |environment: &Environment| {
+            let edges = clearance::edges(environment);
+            StepReport::of(&states, 1000, 3.9, &planned_walk(), (&edges, &SOLE)).unwrap()
+        };
+        let stairs = report(&tread(0.3));
+        assert!(stairs.edge_clearance_m.is_some());
+        let per_stair = stairs.time_per_stair_s.unwrap();
+        assert!((per_stair - 1.3).abs() < 2.0 * DT, "{per_stair}");
+        // Edges no swing passes over (as a ramp's sides): no stairs walked, no time per stair.
+        let elsewhere = report(&tread(10.0));
+        assert_eq!(elsewhere.edge_clearance_m, None);
+        assert_eq!(elsewhere.time_per_stair_s, None);
     }
 
     #[test]
