@@ -88,9 +88,7 @@ impl ParamOverrides {
                 *field = value;
             }
         }
-        if let Some(limit) = self.stair_s_max {
-            p.stair_s_max = Some(limit);
-        }
+        p.stair_s_max = self.stair_s_max.or(p.stair_s_max);
         if let Some(mode) = self.contact_unification {
             p.contact_unification = mode;
         }

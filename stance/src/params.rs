@@ -330,7 +330,7 @@ impl PostProcessParams {
 
     /// The section's table: every numeric key, its value and its range, one line a key.
     pub fn bounds(&self) -> Vec<Bound> {
-        let mut bounds = vec![
+        vec![
             Bound::new("scf", self.scf, 0.01, 1.0),
             Bound::new("s_max", self.s_max, 0.01, 2.0),
             Bound::new("o_min", self.o_min, 0.0, 1.0),
@@ -342,12 +342,8 @@ impl PostProcessParams {
             Bound::new("h_min", self.h_min, 0.0, 0.5),
             Bound::new("h_max", self.h_max, 0.0, 0.5),
             Bound::new("rise_weight", self.rise_weight, 1.0, 10.0),
-        ];
-        bounds.extend(
-            self.stair_s_max
-                .map(|limit| Bound::new("stair_s_max", limit, 0.01, 2.0)),
-        );
-        bounds
+            Bound::optional("stair_s_max", self.stair_s_max, 0.01, 2.0),
+        ]
     }
 
     /// The swing-foot rotation limits `[α_x, α_y, α_z]`.
