@@ -58,21 +58,34 @@ fn walk_to_done(h: &mut Harness, mut observe: impl FnMut(&Harness)) {
 
 /// The landing foot's sensor is dead. The kinematic simulator then puts most of the weight on
 /// that foot, so with the default `support_force_min_fraction` the feet read as unloaded first
-/// (the next test); here that check is relaxed to reach the Lower timeout.
+/// (the next test); here that check is relaxed to reach the Lower timeout. Once the lowering
+/// has ended without a touchdown, the body comes down after the foot (a leg out of reach), but
+/// no more than `standing_crouch_max_m` below its height when the foot was released (here 4 cm,
+/// which the lowering's timeout would pass: JVRC-1's body comes down 4.5 cm in it).
 #[test]
 fn touchdown_never_confirmed_is_a_lower_timeout_fault() {
     let config = ControllerConfig {
         support_force_min_fraction: 0.01,
+        standing_crouch_max_m: 0.04,
         ..walk_support::controller_config("jvrc1")
     };
     let mut h = start(Harness::with_config("jvrc1", config, RATE_HZ), false);
+    run_until(&mut h, Phase::Unload);
+    let released = h.closed.controller.status().com[2];
     run_until(&mut h, Phase::Lower);
     // The force-torque sensor of the landing (right) foot reads nothing from now on.
     let mut ticks = 0;
+    let mut lowest = h.closed.controller.status().com[2];
     while h.closed.controller.status().state == ControllerState::Executing && ticks < MAX_TICKS {
         h.tick_with(|w| w[EndEffector::RightFoot as usize] = [0.0; 6]);
+        lowest = lowest.min(h.closed.controller.status().com[2]);
         ticks += 1;
     }
+    let floor = released - config.standing_crouch_max_m;
+    assert!(
+        (floor - 0.005..floor + 0.005).contains(&lowest),
+        "the body came down to {lowest:.3} m: released at {released:.3} m, floor {floor:.3} m"
+    );
     let status = *h.closed.controller.status();
     assert_eq!(status.state, ControllerState::Fault);
     assert_eq!(status.fault, FaultCode::Timeout(Phase::Lower));

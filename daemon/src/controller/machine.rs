@@ -934,6 +934,32 @@ impl StateMachine {
         }
     }
 
+    /// The CoM height while a foot is lowered (`com_height`: the estimated one, m): free
+    /// (`None`) until the lowering has brought the foot's target to its goal just below the
+    /// surface. A foot still without touchdown then is held up by its leg's reach, and the body
+    /// comes down after it at `lower_speed`, at most `standing_crouch_max_m` below its height at
+    /// the release; a landing that needs more is taken back (`standing_leg_gives_way`). Free,
+    /// the legs' flat-ground posture held ARMAR-4's body up: down the 0.10 m stairs its foot,
+    /// 0.33 m ahead, stopped on the tread with no load (seed 1 of 10) until the lowering timed
+    /// out (MuJoCo).
+    fn body_after_foot(&self, com_height: f64) -> Option<ComHeight> {
+        if self.phase_time < self.motion.duration() || !self.release_com_height.is_finite() {
+            return None;
+        }
+        let lowest = self.release_com_height - self.config.standing_crouch_max_m;
+        Some(if com_height > lowest {
+            ComHeight {
+                height: com_height,
+                velocity: -self.config.lower_speed,
+            }
+        } else {
+            ComHeight {
+                height: lowest,
+                velocity: 0.0,
+            }
+        })
+    }
+
     fn refresh_targets(&mut self, pelvis: &Isometry3<f64>, com_height: f64) {
         let (com, com_velocity) = self.com_motion.sample(self.com_time);
         self.targets.com = com;
@@ -948,12 +974,17 @@ impl StateMachine {
             height: com_height,
             velocity: 0.0,
         });
+        let reaching_down = step
+            .is_some_and(|step| step.phase == Phase::Lower)
+            .then(|| self.body_after_foot(com_height))
+            .flatten();
         self.targets.balance = Balance::SupportPolygon {
             height: self
                 .com_climb
                 .filter(|_| shifting)
                 .map(|climb| climb.height(self.com_time, self.com_motion.duration()))
-                .or(leaning),
+                .or(leaning)
+                .or(reaching_down),
         };
         // A hand being unloaded stays held where it is; a foot being unloaded rises.
         let unloading_foot = step
