@@ -58,6 +58,10 @@ pub struct MatrixArgs {
     /// docs/mujoco.md, "Contacts").
     #[arg(long, default_value_t = MujocoOptions::default().impratio)]
     pub impratio: f64,
+    /// MuJoCo's physics step (s; 1e-5-0.01): whether a cell's result holds at a finer step
+    /// (docs/mujoco.md, "Integrator and step").
+    #[arg(long, default_value_t = MujocoOptions::default().timestep)]
+    pub timestep: f64,
     /// Model error in the simulator only: the pelvis CoM moved by x,y,z (m, pelvis frame; each
     /// within ±0.5, the MuJoCo option `pelvis_com_offset`).
     #[arg(
@@ -267,6 +271,7 @@ pub fn walk_options(args: &MatrixArgs, gait: Gait) -> anyhow::Result<PhysicsWalk
     options.trace_every = 0;
     options.mujoco.mass_scale = args.mass_scale;
     options.mujoco.impratio = args.impratio;
+    options.mujoco.timestep = args.timestep;
     if let Some(offset) = &args.pelvis_com_offset {
         let &[x, y, z] = offset.as_slice() else {
             anyhow::bail!(
@@ -278,7 +283,7 @@ pub fn walk_options(args: &MatrixArgs, gait: Gait) -> anyhow::Result<PhysicsWalk
     options
         .mujoco
         .check()
-        .context("--mass-scale / --pelvis-com-offset / --impratio")?;
+        .context("--mass-scale / --pelvis-com-offset / --impratio / --timestep")?;
     if let Some(path) = &args.scene {
         options.scene = Some(Arc::new(Scene::from_path(path)?));
     }

@@ -242,6 +242,7 @@ fn bench_flags() -> Vec<Flag> {
         ("--rate-hz", Some(RATE_HZ)),
         ("--mass-scale", None),
         ("--impratio", None),
+        ("--timestep", None),
         ("--pelvis-com-offset", None),
         ("--push-impulse", None),
         ("--push-step", None),
