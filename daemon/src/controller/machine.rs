@@ -947,16 +947,14 @@ impl StateMachine {
             return None;
         }
         let lowest = self.release_com_height - self.config.standing_crouch_max_m;
-        Some(if com_height > lowest {
-            ComHeight {
-                height: com_height,
-                velocity: -self.config.lower_speed,
-            }
-        } else {
-            ComHeight {
-                height: lowest,
-                velocity: 0.0,
-            }
+        let descending = com_height > lowest;
+        Some(ComHeight {
+            height: com_height.max(lowest),
+            velocity: if descending {
+                -self.config.lower_speed
+            } else {
+                0.0
+            },
         })
     }
 
@@ -975,9 +973,8 @@ impl StateMachine {
             velocity: 0.0,
         });
         let reaching_down = step
-            .is_some_and(|step| step.phase == Phase::Lower)
-            .then(|| self.body_after_foot(com_height))
-            .flatten();
+            .filter(|step| step.phase == Phase::Lower)
+            .and_then(|_| self.body_after_foot(com_height));
         self.targets.balance = Balance::SupportPolygon {
             height: self
                 .com_climb
