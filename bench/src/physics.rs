@@ -22,7 +22,7 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use client::evaluate::actuators::ActuatorReport;
 use client::evaluate::hands::hand_planned_held;
-use client::evaluate::{Points, TraceSample, align_targets, stance_points};
+use client::evaluate::{Points, TraceSample, WATCH_AFTER_END_S, align_targets, stance_points};
 use daemon::controller::{
     BalanceStatus, Controller, ControllerConfig, ControllerState, ControllerStatus,
     DynamicGaitConfig, FaultCode, Gait, GaitConfig, Phase, SolverKind,
@@ -51,7 +51,7 @@ pub struct PhysicsWalkOptions {
     /// (as `walkd bench`).
     pub time_limit_s: Option<f64>,
     /// Simulated time the final posture (or a fault's hold) is held after `Done` (or the fault)
-    /// while still checking for a fall (s).
+    /// while still checking for a fall (s); by default as long as `walkctl evaluate` watches.
     pub settle_s: f64,
     /// Every this many ticks one [`TraceSample`] is recorded (0: no trace).
     pub trace_every: u64,
@@ -74,7 +74,7 @@ impl Default for PhysicsWalkOptions {
             solver: SolverKind::Dense,
             rate_hz: 500.0,
             time_limit_s: None,
-            settle_s: 1.0,
+            settle_s: WATCH_AFTER_END_S,
             trace_every: 10,
             mujoco: MujocoOptions::default(),
             gait: Gait::Static,

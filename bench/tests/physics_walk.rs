@@ -199,10 +199,7 @@ mod walks {
         let mut file = config("armar4");
         file.set("controller.hand_weight=1.0")
             .expect("a valid override");
-        let options = PhysicsWalkOptions {
-            settle_s: 3.0,
-            ..PhysicsWalkOptions::default()
-        };
+        let options = PhysicsWalkOptions::default();
         let request = WalkRequest {
             distance: 5.0,
             affordances: AffordanceSet::FeetLeftHand,
@@ -237,7 +234,6 @@ mod walks {
         let options = PhysicsWalkOptions {
             gait: stance::Gait::Static,
             scene: Some(scene.clone()),
-            settle_s: 3.0,
             ..PhysicsWalkOptions::default()
         };
         let request = WalkRequest {

@@ -304,7 +304,6 @@ pub fn run_demo(args: &DemoArgs) -> anyhow::Result<DemoOutcome> {
             .as_ref()
             .map(|dir| dir.join(format!("demo-{}.mcap", args.robot.name()))),
         telemetry: gait == Gait::Dynamic && args.plots.is_some(),
-        linger: Duration::ZERO,
         timeout: Duration::from_secs(60 + 30 * sequence.len() as u64),
         on_status: &|status| {
             if let Some(progress) = &progress {

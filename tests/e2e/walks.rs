@@ -156,6 +156,12 @@ fn assert_tracked_truth(run: &serde_json::Value, max_drift: f64) {
 fn jvrc1_walks_under_mujoco_physics_without_falling() {
     let run = evaluate_walk("jvrc1", "mujoco", 0.4);
     assert_tracked_truth(&run, 0.02);
+    // Still standing after being watched past the end (a fall then is no `done`).
+    let watched = run["watched_after_end_s"].as_f64().unwrap();
+    assert!(
+        watched >= client::evaluate::WATCH_AFTER_END_S,
+        "watched {watched} s: {run}"
+    );
     // Upright all the way (the fall rule is 0.6 rad).
     assert!(run["max_tilt_rad"].as_f64().unwrap() < 0.1, "{run}");
 }

@@ -4,9 +4,9 @@
 //! turned into the simulator's verdict (fall, tilt, final state).
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use shm_types::{ServiceNames, SimTruth, TruthSubscriber};
@@ -16,9 +16,14 @@ use super::footholds;
 /// How often the recorder drains the subscriber.
 const DRAIN_PERIOD: Duration = Duration::from_micros(500);
 
+/// How often [`TruthRecorder::wait_for_sim_time`] looks at the newest state.
+const WAIT_PERIOD: Duration = Duration::from_millis(5);
+
 /// Records every state `walk-sim` publishes on a prefix until [`TruthRecorder::finish`].
 pub(crate) struct TruthRecorder {
     stop: Arc<AtomicBool>,
+    /// The newest recorded state's `sim_time_s` as `f64` bits; NaN before the first.
+    newest_sim_time: Arc<AtomicU64>,
     handle: JoinHandle<anyhow::Result<Vec<SimTruth>>>,
 }
 
@@ -29,6 +34,8 @@ impl TruthRecorder {
         let names = ServiceNames::new(prefix)?;
         let stop = Arc::new(AtomicBool::new(false));
         let stopped = Arc::clone(&stop);
+        let newest_sim_time = Arc::new(AtomicU64::new(f64::NAN.to_bits()));
+        let newest = Arc::clone(&newest_sim_time);
         let (ready, subscribed) = std::sync::mpsc::channel();
         let handle = std::thread::spawn(move || {
             // iceoryx2 ports stay on the thread that created them.
@@ -46,6 +53,9 @@ impl TruthRecorder {
             loop {
                 let last_round = stopped.load(Ordering::Relaxed);
                 subscriber.drain(|truth| states.push(*truth))?;
+                if let Some(state) = states.last() {
+                    newest.store(state.sim_time_s.to_bits(), Ordering::Relaxed);
+                }
                 if last_round {
                     return Ok(states);
                 }
@@ -53,9 +63,36 @@ impl TruthRecorder {
             }
         });
         match subscribed.recv() {
-            Ok(None) => Ok(Self { stop, handle }),
+            Ok(None) => Ok(Self {
+                stop,
+                newest_sim_time,
+                handle,
+            }),
             Ok(Some(error)) => anyhow::bail!("subscribing to the simulator's truth: {error}"),
             Err(_) => anyhow::bail!("the simulator-truth recorder ended before subscribing"),
+        }
+    }
+
+    /// Simulated time of the newest state recorded (s); `None` before the first.
+    fn newest_sim_time(&self) -> Option<f64> {
+        let time = f64::from_bits(self.newest_sim_time.load(Ordering::Relaxed));
+        (!time.is_nan()).then_some(time)
+    }
+
+    /// Keeps recording until the simulator's clock has advanced `span_s` past the newest state
+    /// recorded now, or `wall_limit` has passed (a simulator that stalled); at once when nothing
+    /// has been recorded (no simulator: a real robot).
+    pub(crate) fn wait_for_sim_time(&self, span_s: f64, wall_limit: Duration) {
+        let Some(from) = self.newest_sim_time() else {
+            return;
+        };
+        let wall = Instant::now();
+        while wall.elapsed() < wall_limit
+            && self
+                .newest_sim_time()
+                .is_some_and(|now| now < from + span_s)
+        {
+            std::thread::sleep(WAIT_PERIOD);
         }
     }
 

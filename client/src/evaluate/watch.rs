@@ -1,5 +1,5 @@
-//! One post-processed sequence submitted to a running walkd and watched to its end from beside
-//! it: the status stream as a Fig. 6 trace, the simulator's truth, the dynamic gait's balance
+//! One post-processed sequence submitted to a running walkd and watched from beside it to its
+//! end and [`WATCH_AFTER_END_S`] beyond (whether the robot stays up): the status stream as a Fig. 6 trace, the simulator's truth, the dynamic gait's balance
 //! telemetry and, if asked, an MCAP recording. `walkctl evaluate` and `walkctl demo` both walk
 //! through here.
 
@@ -12,6 +12,7 @@ use nalgebra::Isometry3;
 use shm_types::{DaemonStatus, SimTruth};
 use stance::PostProcessedSequence;
 
+use super::WATCH_AFTER_END_S;
 use super::telemetry::{AskedForce, StateChange, TelemetryRecorder};
 use super::timing::PlannedPhase;
 use super::truth::{TruthRecorder, Verdict, state_at};
@@ -20,6 +21,10 @@ use crate::daemon_client::DaemonClient;
 use crate::observe::channels::isometry;
 use crate::observe::{Recorder, RecorderOutcome};
 
+/// The longest wall time spent on [`WATCH_AFTER_END_S`]: a simulator that stops publishing
+/// does not hold the watch up.
+const WATCH_WALL_LIMIT: Duration = Duration::from_secs(60);
+
 /// What to record besides the status stream and the simulator's truth.
 pub(crate) struct WatchOptions<'a> {
     /// Record the walk (an observer beside walkd) to this MCAP file.
@@ -27,8 +32,6 @@ pub(crate) struct WatchOptions<'a> {
     /// Record walkd's telemetry: the dynamic gait's ZMP and DCM, the daemon's state changes, the
     /// planned phases and the hands in contact.
     pub telemetry: bool,
-    /// Keep recording this long after the walk ended (to see whether the robot stays up).
-    pub linger: Duration,
     /// How long the walk may take before it counts as stuck.
     pub timeout: Duration,
     /// Called with every status while the walk runs (e.g. a progress line).
@@ -50,6 +53,9 @@ pub(crate) struct WatchedWalk {
     pub wall_s: f64,
     /// Simulated time from submission to the walk's last status (s).
     pub sim_s: f64,
+    /// Simulated time the robot was watched past the walk's last status (s; at least
+    /// [`WATCH_AFTER_END_S`] unless the simulator stalled); `None` without its truth.
+    pub watched_after_end_s: Option<f64>,
     /// Monotonic time of the submission (ns).
     pub submitted_ns: u64,
     /// Every state the simulator published meanwhile.
@@ -127,7 +133,7 @@ pub(crate) fn watch_walk(
         }
     })?;
     let wall_s = wall.elapsed().as_secs_f64();
-    std::thread::sleep(options.linger);
+    recorder.wait_for_sim_time(WATCH_AFTER_END_S, WATCH_WALL_LIMIT);
     let recording = observer.map(Recorder::finish).transpose()?;
     let states = recorder.finish()?;
     let (balance, state_changes, phases, hands_held, hands_asked, hand_forces) = match telemetry {
@@ -155,8 +161,12 @@ pub(crate) fn watch_walk(
         (Some(submitted), Some(end)) => end.sim_time_s - submitted.sim_time_s,
         _ => last.ticks.saturating_sub(start.ticks) as f64 / last.rate_hz,
     };
+    let watched_after_end_s = state_at(&states, last.timestamp_ns)
+        .zip(states.last())
+        .map(|(end, newest)| newest.sim_time_s - end.sim_time_s);
     Ok(WatchedWalk {
         sim_s,
+        watched_after_end_s,
         verdict: Verdict::of(&states, submitted_ns),
         start,
         last,
