@@ -193,7 +193,8 @@ mod walks {
     /// tipping fault (0.25 rad) came too late, and the robot fell a second later holding its
     /// swing foot in the air. Now it catches itself on that foot from `catch_tilt_rad` and stands
     /// in the fault; whether or not a later change keeps it from tipping at all, it must not
-    /// fall.
+    /// fall. (At a 0.5 ms MuJoCo step the foot put straight down did not catch it; it lands
+    /// where the tilt carries the CoM: docs/controller.md, "Catch step".)
     #[test]
     fn armar4_tipping_mid_swing_does_not_fall() {
         let mut file = config("armar4");

@@ -335,9 +335,33 @@ fn an_imu_tilted_away_from_leg_odometry_is_a_tipping_fault_that_holds() {
 
 /// A static walk tipping mid-swing (the IMU rolled from leg odometry past `catch_tilt_rad`,
 /// short of the tipping fault's angle) does not go on, nor freeze its swing foot in the air: it
-/// puts it straight down, then holds in the tipping fault, standing on both feet.
+/// puts it down, then holds in the tipping fault, standing on both feet. Tipping towards the
+/// swing foot, the foot lands further out by about how far the tilt carried the CoM (MuJoCo:
+/// ARMAR-4 putting it straight down rolled over it, `physics_walk`); tipping away, the foot
+/// comes straight down rather than across the standing one.
 #[test]
 fn a_robot_tipping_mid_swing_puts_its_swing_foot_down_then_holds() {
+    let config = walk_support::controller_config("jvrc1");
+    let roll = (config.catch_tilt_rad + config.tipping_detection_rad) / 2.0;
+    let (caught, landed, com_height) = tip_mid_swing(roll, true);
+    let outwards = landed - caught;
+    assert!(
+        outwards > 0.5 * roll * com_height,
+        "tipped {roll} rad towards it, the foot landed {outwards} m further out \
+         ({caught} → {landed} m from the standing foot)"
+    );
+    let (caught, landed, _) = tip_mid_swing(roll, false);
+    assert!(
+        (landed - caught).abs() < 0.01,
+        "tipped away from it, the foot came down {caught} → {landed} m from the standing foot"
+    );
+}
+
+/// Walks JVRC-1 into its first swing, tips the IMU by `roll` (rad) towards the swing foot's side
+/// (`towards`) or away from it, and ticks until the catch has landed and holds. Returns the
+/// swing sole's horizontal distance from the standing one when tipped and when landed, and the
+/// CoM height above the soles (m).
+fn tip_mid_swing(roll: f64, towards: bool) -> (f64, f64, f64) {
     let mut h = started("jvrc1", false);
     run_until(&mut h, Phase::Swing);
     for _ in 0..20 {
@@ -345,19 +369,25 @@ fn a_robot_tipping_mid_swing_puts_its_swing_foot_down_then_holds() {
     }
     let status = *h.closed.controller.status();
     assert_eq!(status.phase, Phase::Swing, "{status:?}");
-    let swinging = if status.contacts[EndEffector::LeftFoot as usize] {
-        EndEffector::RightFoot
+    let (swinging, standing) = if status.contacts[EndEffector::LeftFoot as usize] {
+        (EndEffector::RightFoot, EndEffector::LeftFoot)
     } else {
-        EndEffector::LeftFoot
+        (EndEffector::LeftFoot, EndEffector::RightFoot)
     };
-    let height = |h: &Harness| h.closed.sim.end_effector_pose(swinging).translation.z;
-    let lifted = height(&h);
+    let sole = |h: &Harness, foot| h.closed.sim.end_effector_pose(foot).translation.vector;
+    let apart = |h: &Harness| (sole(h, swinging) - sole(h, standing)).xy().norm();
+    let lifted = sole(&h, swinging).z;
     assert!(lifted > 0.01, "the swing foot is in the air: {lifted} m");
+    let com_height = status.com[2] - sole(&h, standing).z;
     let config = walk_support::controller_config("jvrc1");
+    assert!(config.catch_tilt_rad < roll && roll < config.tipping_detection_rad);
+    // A roll about +x tips the robot towards −y, the right foot's side.
+    let right = swinging == EndEffector::RightFoot;
+    let sign = if right == towards { 1.0 } else { -1.0 };
     let m = h.closed.sim.measurement().clone();
-    assert!(config.catch_tilt_rad < config.tipping_detection_rad);
-    let roll = (config.catch_tilt_rad + config.tipping_detection_rad) / 2.0;
-    let tipped = nalgebra::UnitQuaternion::from_euler_angles(roll, 0.0, 0.0) * m.base_orientation;
+    let tipped =
+        nalgebra::UnitQuaternion::from_euler_angles(sign * roll, 0.0, 0.0) * m.base_orientation;
+    let caught = apart(&h);
     tick_with_imu(&mut h, tipped);
     let status = *h.closed.controller.status();
     assert_eq!(status.state, ControllerState::ControlledStop, "{status:?}");
@@ -388,8 +418,10 @@ fn a_robot_tipping_mid_swing_puts_its_swing_foot_down_then_holds() {
             && status.contacts[EndEffector::RightFoot as usize],
         "stands on both feet: {status:?}"
     );
-    assert!(height(&h) < 0.005, "landed: {} m", height(&h));
+    let landed = sole(&h, swinging).z;
+    assert!(landed < 0.005, "landed: {landed} m");
     assert_eq!(h.closed.command.mode, CommandMode::Hold);
+    (caught, apart(&h), com_height)
 }
 
 #[test]

@@ -385,9 +385,12 @@ impl StateMachine {
     /// standing, then is lowered as every foot is, until its touchdown is confirmed, and the
     /// walk ends (`Done`). A tipping robot's estimate holds the standing foot flat, so the
     /// ground under the lifted foot lies above that plane on the side it tips to, and the foot
-    /// meets it during the fast part. False, and nothing changes, when no foot is lifting,
-    /// swinging or lowering over one standing.
-    pub fn catch_swing_foot(&mut self, poses: &[Isometry3<f64>; 4]) -> bool {
+    /// meets it during the fast part. It comes down `tipped` (world, m: how far the tilt has
+    /// carried the CoM beyond the estimate) from where it is, so the support it makes lies
+    /// where the CoM is going, unless that is nearer the standing foot (the feet would cross):
+    /// then straight below. False, and nothing changes, when no foot is lifting, swinging or
+    /// lowering over one standing.
+    pub fn catch_swing_foot(&mut self, poses: &[Isometry3<f64>; 4], tipped: Vector2<f64>) -> bool {
         let step = self.started.then(|| self.current_step());
         let Some(Step {
             phase: Phase::Lift | Phase::Swing | Phase::Lower,
@@ -403,8 +406,15 @@ impl StateMachine {
             return false;
         };
         let start = poses[foot as usize];
+        let standing = &self.targets.anchors[standing as usize].translation.vector;
         let mut below = heading_frame(&start);
-        below.translation.z = self.targets.anchors[standing as usize].translation.z;
+        below.translation.z = standing.z;
+        let apart =
+            |shift: Vector2<f64>| (start.translation.vector.xy() + shift - standing.xy()).norm();
+        if apart(tipped) >= apart(Vector2::zeros()) {
+            below.translation.x += tipped.x;
+            below.translation.y += tipped.y;
+        }
         self.motion = PoseTrajectory::new(start, below, CATCH_S, Profile::Linear);
         self.motion_is_via = false;
         self.plan = TransitionPlan::catch(foot);

@@ -56,7 +56,7 @@ use std::sync::Arc;
 use kinematics::configuration::Configuration;
 use kinematics::kinematics::Kinematics;
 use kinematics::robot::{EndEffector, Robot};
-use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 pub use config::{ConfigError, ControllerConfig};
 pub use gait::{DynamicGaitConfig, GaitConfig, StabilizerConfig};
@@ -690,7 +690,11 @@ impl Controller {
                 self.stop_ends_in == ControllerState::Fault
                     && self.status.fault == FaultCode::Tipping
             }
-            ControllerState::Executing if self.machine.catch_swing_foot(&self.poses) => {
+            ControllerState::Executing
+                if self
+                    .machine
+                    .catch_swing_foot(&self.poses, self.tipped_com_offset()) =>
+            {
                 self.status.state = ControllerState::ControlledStop;
                 self.status.fault = FaultCode::Tipping;
                 self.stop_ends_in = ControllerState::Fault;
@@ -698,6 +702,22 @@ impl Controller {
             }
             _ => false,
         }
+    }
+
+    /// How far the tilt the IMU sees beyond leg odometry's has carried the CoM horizontally
+    /// (world, m): the difference of the two verticals times the CoM's height above the lower
+    /// foot (small angles); zero without an IMU.
+    fn tipped_com_offset(&self) -> Vector2<f64> {
+        let Some(imu) = self.last_imu else {
+            return Vector2::zeros();
+        };
+        let up = Vector3::z();
+        let lean = imu * up - self.configuration.base.rotation * up;
+        let ground = self.poses[EndEffector::LeftFoot as usize]
+            .translation
+            .z
+            .min(self.poses[EndEffector::RightFoot as usize].translation.z);
+        lean.xy() * (self.kinematics.com().z - ground)
     }
 
     /// While a walk executes on force-torque it trusts, the feet must carry at least

@@ -4,7 +4,7 @@
 //! when it ends, however it ends.
 
 use kinematics::robot::{EndEffector, SoleRectangle};
-use nalgebra::{DVector, Isometry3};
+use nalgebra::{DVector, Isometry3, Vector2};
 
 use super::config::ControllerConfig;
 use super::gait::{DynamicWalker, Sensors};
@@ -76,8 +76,8 @@ impl Sequencer {
 
     /// Puts the static gait's foot in the air down at once, ending the walk
     /// (`StateMachine::catch_swing_foot`); false when there is none (or a dynamic walk runs).
-    pub fn catch_swing_foot(&mut self, poses: &[Isometry3<f64>; 4]) -> bool {
-        !self.dynamic.running() && self.fallback.catch_swing_foot(poses)
+    pub fn catch_swing_foot(&mut self, poses: &[Isometry3<f64>; 4], tipped: Vector2<f64>) -> bool {
+        !self.dynamic.running() && self.fallback.catch_swing_foot(poses, tipped)
     }
 
     /// Whether the feet's force-torque readings are trusted: false during a controlled stop that
