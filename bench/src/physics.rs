@@ -2,7 +2,7 @@
 //! closed loop with `sim_adapter::mujoco::MujocoSim` (feature `mujoco`).
 //!
 //! Each control tick the controller reads the simulator's joint encoders, foot FT wrenches and
-//! IMU orientation, and the simulator advances one control period (two 1 ms physics steps at
+//! IMU orientation, and the simulator advances one control period (four 0.5 ms physics steps at
 //! 500 Hz) with the servos tracking the command. A walk succeeds when the controller reaches
 //! `Done` and the simulated robot never fell (base height and torso tilt,
 //! [`MujocoSim::has_fallen`]) — neither during the walk nor while holding the final posture for

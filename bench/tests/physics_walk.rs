@@ -1,5 +1,5 @@
 //! The controller walks without falling under rigid-body physics: `daemon::controller` in closed
-//! loop with MuJoCo (`walk_bench::physics`), 500 Hz control, 1 ms physics steps, measurement
+//! loop with MuJoCo (`walk_bench::physics`), 500 Hz control, 0.5 ms physics steps, measurement
 //! from the simulated FT sensors, joint encoders and IMU. Each test walks forward (1 m for every
 //! robot and affordance set, 5 m feet-only per robot; the dynamic gait on JVRC-1, 1 m and 5 m,
 //! and on ARMAR-4, 1 m)

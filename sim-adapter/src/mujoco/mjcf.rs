@@ -568,7 +568,8 @@ mod tests {
     fn without_a_terrain_the_model_is_the_flat_floor_one() {
         // Fingerprints and lengths of the documents written before terrain existed: flat walks
         // simulate the same model as then, plus the palms and the wrist FT sites (4 lines) and
-        // the friction's stiffness (`impratio`, an attribute of the option line).
+        // the friction's stiffness (`impratio`, an attribute of the option line), at a finer
+        // physics step (the option line's `timestep`, compared as the 1 ms it then was).
         for (name, visual_geoms, hash, length) in [
             ("jvrc1", true, 0xf8c7_5ae0_ad90_45b8, 23057),
             ("jvrc1", false, 0x58e2_14e4_fe88_b33c, 18344),
@@ -589,7 +590,12 @@ mod tests {
             assert_eq!(added.len(), 4, "{name}: {added:?}");
             let stiffness = format!(r#" impratio="{}""#, options.impratio);
             assert_eq!(written.matches(&stiffness).count(), 1, "{name}");
-            let xml = kept.concat().replace(&stiffness, "");
+            let step = format!(r#"timestep="{}""#, options.timestep);
+            assert_eq!(written.matches(&step).count(), 1, "{name}");
+            let xml = kept
+                .concat()
+                .replace(&stiffness, "")
+                .replace(&step, r#"timestep="0.001""#);
             assert_eq!(
                 (fingerprint(&xml), xml.len()),
                 (hash, length),

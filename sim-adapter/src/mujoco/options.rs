@@ -14,10 +14,13 @@ use super::MujocoError;
 /// The default servos are stiff (kp 1e5 N·m/rad, kv 1000 N·m·s/rad): the loaded joints of a
 /// stance leg must not yield millimetres under the robot's weight, or the controller's task errors
 /// never settle inside its tolerances (with kp 3e4 / kv 300 a JVRC-1 foot lift settled 7.5 mm from
-/// its goal). The armature of 0.2 kg·m² keeps them stable at the 1 ms step:
-/// `kp·h²/armature` = 1e5 · 1e-6 / 0.2 = 0.5. Stable, but the soles' contacts are not converged
-/// there: results change at 0.5 ms and stay put at 0.25 ms (docs/mujoco.md, "Integrator and
-/// step"); 0.5 ms is not the default yet because not everything has been measured there.
+/// its goal). The armature of 0.2 kg·m² keeps them stable at the step: `kp·h²/armature` =
+/// 1e5 · 0.25e-6 / 0.2 = 0.125 at 0.5 ms.
+///
+/// The step is 0.5 ms: at 1 ms (the default until 2026-12-07, `kp·h²/armature` 0.5) the soles'
+/// contacts were not converged. JVRC-1's dynamic gait up the 0.15 m stairs (in process, 500 Hz):
+/// 28/30 at 1 ms, largest tilt 0.067 rad; 30/30 at 0.5 ms, 0.032 rad; 10/10 at 0.25 ms, 0.032
+/// rad; at a 1 kHz control rate 5/10 at 1 ms, 10/10 at 0.5 and 0.25 ms (docs/mujoco.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MujocoOptions {
     /// Physics time step (s); `step(dt)` runs as many of these as fit in `dt`.
@@ -68,7 +71,7 @@ pub struct MujocoOptions {
 impl Default for MujocoOptions {
     fn default() -> Self {
         Self {
-            timestep: 0.001,
+            timestep: 0.0005,
             servo_stiffness: 1.0e5,
             servo_damping: 1000.0,
             armature: 0.2,
