@@ -1,7 +1,7 @@
 //! One post-processed sequence submitted to a running walkd and watched from beside it to its
-//! end and [`WATCH_AFTER_END_S`] beyond (whether the robot stays up): the status stream as a Fig. 6 trace, the simulator's truth, the dynamic gait's balance
-//! telemetry and, if asked, an MCAP recording. `walkctl evaluate` and `walkctl demo` both walk
-//! through here.
+//! end and [`WATCH_AFTER_END_S`] beyond (whether the robot stays up): the status stream as a
+//! Fig. 6 trace, the simulator's truth, the dynamic gait's balance telemetry and, if asked, an
+//! MCAP recording. `walkctl evaluate` and `walkctl demo` both walk through here.
 
 use std::path::PathBuf;
 use std::sync::Arc;

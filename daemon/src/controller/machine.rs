@@ -406,11 +406,12 @@ impl StateMachine {
             return false;
         };
         let start = poses[foot as usize];
-        let standing = &self.targets.anchors[standing as usize].translation.vector;
+        let standing_sole = &self.targets.anchors[standing as usize].translation.vector;
         let mut below = heading_frame(&start);
-        below.translation.z = standing.z;
-        let apart =
-            |shift: Vector2<f64>| (start.translation.vector.xy() + shift - standing.xy()).norm();
+        below.translation.z = standing_sole.z;
+        let apart = |shift: Vector2<f64>| {
+            (start.translation.vector.xy() + shift - standing_sole.xy()).norm()
+        };
         if apart(tipped) >= apart(Vector2::zeros()) {
             below.translation.x += tipped.x;
             below.translation.y += tipped.y;

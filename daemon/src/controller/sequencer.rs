@@ -74,8 +74,9 @@ impl Sequencer {
         }
     }
 
-    /// Puts the static gait's foot in the air down at once, ending the walk
-    /// (`StateMachine::catch_swing_foot`); false when there is none (or a dynamic walk runs).
+    /// Puts the static gait's foot in the air down at once, `tipped` (m) from below it, ending
+    /// the walk (`StateMachine::catch_swing_foot`); false when there is none (or a dynamic walk
+    /// runs).
     pub fn catch_swing_foot(&mut self, poses: &[Isometry3<f64>; 4], tipped: Vector2<f64>) -> bool {
         !self.dynamic.running() && self.fallback.catch_swing_foot(poses, tipped)
     }
