@@ -154,14 +154,12 @@ pub(crate) fn watch_walk(
     // Simulated time from the submission to the tick of the last status: by the simulator's
     // clock where it published its truth (the ticks between the status read before submitting
     // and the submission are no part of the walk), else by walkd's ticks.
-    let sim_s = match (
-        state_at(&states, submitted_ns),
-        state_at(&states, last.timestamp_ns),
-    ) {
+    let end = state_at(&states, last.timestamp_ns);
+    let sim_s = match (state_at(&states, submitted_ns), end) {
         (Some(submitted), Some(end)) => end.sim_time_s - submitted.sim_time_s,
         _ => last.ticks.saturating_sub(start.ticks) as f64 / last.rate_hz,
     };
-    let watched_after_end_s = state_at(&states, last.timestamp_ns)
+    let watched_after_end_s = end
         .zip(states.last())
         .map(|(end, newest)| newest.sim_time_s - end.sim_time_s);
     Ok(WatchedWalk {
