@@ -108,7 +108,7 @@ pub const GAIT_DYNAMIC: [(&str, Tuned); 19] = [
     ("max_step_down_m", Tuned::Number(0.15)),
     ("max_slope_rad", Tuned::Number(0.27)),
     ("toe_off_rad", Tuned::Number(0.5)),
-    ("toe_off_s", Tuned::Number(0.3)),
+    ("toe_off_s", Tuned::Number(0.25)),
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic.stabilizer]`, in its order.

@@ -6,7 +6,9 @@
 //!   foot that stays), at whose end the foot lifts off; it lasts `double_support_s`, the first
 //!   one `initial_double_support_s`, so the CoM can start from rest, and one next to a step up
 //!   or down (after its touchdown or before its lift-off) `step_double_support_s`, next to a
-//!   stair climbed (level soles) with no other step on its other side `climb_double_support_s`;
+//!   stair climbed (level soles) with no other step on its other side `climb_double_support_s`,
+//!   and between stairs climbed past the other foot (one foot per stair)
+//!   `climb_past_double_support_s`;
 //! - a foot added (single → double support): the single-support phase in which it swings, from
 //!   lift-off through the highest post-processed swing pose of its flight to its contact pose;
 //!   it lasts `single_support_s` (a stair climbed: `climb_single_support_s`, past the other
@@ -277,11 +279,12 @@ impl Builder<'_> {
         for f in 0..2 {
             if released[f] {
                 let lift_off = self.feet[f].unwrap_or_else(Isometry3::identity);
+                let standing = self.feet[1 - f];
                 let step_ahead = upcoming
                     .iter()
                     .find(|s| s.contacts[FEET[f] as usize])
                     .map_or(Rise::Level, |s| {
-                        Rise::of(&lift_off, &s.targets[FEET[f] as usize])
+                        Rise::of(&lift_off, &s.targets[FEET[f] as usize], standing.as_ref())
                     });
                 let duration = self.lift_off_double_support(step_ahead);
                 self.double_support(duration, Some(FEET[f]));
@@ -305,7 +308,8 @@ impl Builder<'_> {
     /// support's previous phase, if all timed, else `double_support_s`; the first lift-off from
     /// standing no shorter than `initial_double_support_s` (the CoM starts from rest), and one
     /// after a step up or down or before one (`step_ahead`) no shorter than
-    /// `climb_double_support()` when both are level or a stair climbed, else
+    /// `climb_past_double_support()` when each is level or a stair climbed past the other foot,
+    /// `climb_double_support()` when each is level or a stair climbed, else
     /// `step_double_support()`.
     fn lift_off_double_support(&mut self, step_ahead: Rise) -> (f64, PhaseTiming) {
         let limits = self.timing.timed_double_support();
@@ -314,8 +318,10 @@ impl Builder<'_> {
         if self.stepped && sides.iter().any(|r| *r != Rise::Level) {
             let step = if sides.contains(&Rise::Step) {
                 self.timing.step_double_support()
-            } else {
+            } else if sides.contains(&Rise::Stair) {
                 self.timing.climb_double_support()
+            } else {
+                self.timing.climb_past_double_support()
             };
             timed(dwell, step, limits, step)
         } else if self.stepped {
@@ -339,11 +345,9 @@ impl Builder<'_> {
     ) -> (f64, PhaseTiming) {
         let limits = self.timing.timed_single_support();
         let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
-        let step = match Rise::of(lift_off, landing) {
+        let step = match Rise::of(lift_off, landing, standing) {
             Rise::Level => return timed(dwell, self.timing.single_support_s, limits, 0.0),
-            Rise::Stair if standing.is_some_and(|s| climbs_past(lift_off, landing, s)) => {
-                self.timing.climb_past_single_support()
-            }
+            Rise::StairPast => self.timing.climb_past_single_support(),
             Rise::Stair => self.timing.climb_single_support(),
             Rise::Step => self.timing.step_single_support(),
         };
@@ -369,7 +373,7 @@ impl Builder<'_> {
         );
         self.feet[slot(foot)] = Some(landing);
         self.stepped = true;
-        self.after_step = Rise::of(&lift_off, &landing);
+        self.after_step = Rise::of(&lift_off, &landing, standing.as_ref());
     }
 
     fn double_support(&mut self, duration: (f64, PhaseTiming), lift_off: Option<EndEffector>) {
@@ -410,6 +414,9 @@ enum Rise {
     Level,
     /// Up from a level sole to a level sole: a stair climbed (`climb_*` timing).
     Stair,
+    /// A stair climbed past the foot standing: from below it to above it, one foot per stair
+    /// (`climb_past_*` timing).
+    StairPast,
     /// Any other step: down, or up or onto a slope (`step_*` timing).
     Step,
 }
@@ -418,8 +425,12 @@ enum Rise {
 const LEVEL_SOLE_RAD: f64 = 0.02;
 
 impl Rise {
-    /// A swing from `lift_off` landing at `landing`.
-    fn of(lift_off: &Isometry3<f64>, landing: &Isometry3<f64>) -> Self {
+    /// A swing from `lift_off` landing at `landing` while the other foot stands at `standing`.
+    fn of(
+        lift_off: &Isometry3<f64>,
+        landing: &Isometry3<f64>,
+        standing: Option<&Isometry3<f64>>,
+    ) -> Self {
         let rise = landing.translation.z - lift_off.translation.z;
         let level = |pose: &Isometry3<f64>| {
             (pose.rotation * Vector3::z()).angle(&Vector3::z()) < LEVEL_SOLE_RAD
@@ -427,7 +438,11 @@ impl Rise {
         if rise.abs() <= STEP_HEIGHT_M {
             Self::Level
         } else if rise > 0.0 && level(lift_off) && level(landing) {
-            Self::Stair
+            if standing.is_some_and(|s| climbs_past(lift_off, landing, s)) {
+                Self::StairPast
+            } else {
+                Self::Stair
+            }
         } else {
             Self::Step
         }
@@ -533,7 +548,7 @@ mod tests {
     }
 
     #[test]
-    fn a_stair_climbed_past_the_other_foot_takes_the_climb_past_single_support() {
+    fn a_stair_climbed_past_the_other_foot_takes_the_climb_past_supports() {
         let timing = DynamicGaitConfig::default();
         // One foot per 0.10 m stair: the left onto the first tread, beside the right on the
         // floor; then each foot from the tread below the other's to the one above it.
@@ -553,6 +568,19 @@ mod tests {
             [timing.climb_single_support(), past, past]
         );
         assert!(past > timing.climb_single_support());
+        // Between the first stair (beside the other foot) and a climb past it: the climb's
+        // double support; between two climbs past: the shorter one of its own.
+        let between = timing.climb_past_double_support();
+        assert_eq!(
+            durations(&plan, false),
+            [
+                timing.initial_double_support_s,
+                timing.climb_double_support(),
+                between,
+                timing.final_double_support_s
+            ]
+        );
+        assert!(between < timing.climb_double_support());
     }
 
     #[test]
