@@ -112,7 +112,7 @@ pub const GAIT_DYNAMIC: [(&str, Tuned); 19] = [
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic.stabilizer]`, in its order.
-pub const STABILIZER: [(&str, Tuned); 19] = [
+pub const STABILIZER: [(&str, Tuned); 22] = [
     ("zmp_margin_m", Tuned::Number(0.01)),
     ("dcm_feedback", Tuned::Switch(false)),
     ("dcm_gain", Tuned::Number(3.0)),
@@ -128,6 +128,9 @@ pub const STABILIZER: [(&str, Tuned); 19] = [
     ("force_difference", Tuned::Switch(true)),
     ("force_difference_gain", Tuned::Number(1e-5)),
     ("force_difference_max_speed", Tuned::Number(0.02)),
+    ("internal_force", Tuned::Switch(true)),
+    ("internal_force_gain", Tuned::Number(1e-4)),
+    ("internal_force_max_speed", Tuned::Number(0.02)),
     ("tilt_damping", Tuned::Switch(true)),
     ("tilt_damping_s", Tuned::Number(0.03)),
     ("tilt_rate_filter_s", Tuned::Number(0.01)),

@@ -18,6 +18,14 @@
 //! - **Force difference** (double support): the feet move vertically against each other,
 //!   `v = K (Δf_d − Δf_m)` with `Δf = f_left − f_right` (K in m/s per N): the left foot by
 //!   `−v/2`, the right by `+v/2`, so the foot that should carry more presses down.
+//! - **Internal force** (double support): two legs on the ground form a closed chain, and stiff
+//!   position servos holding it where the model closes it (their joints sag under load by a
+//!   fraction of a milliradian, the feet were anchored under another load) push the feet against
+//!   each other: standing after a walk up the stairs, JVRC-1's feet pushed each other with 90 N
+//!   and a hip pitch sat at its 100 N·m limit. The part of each foot's horizontal ground force
+//!   beyond its share of the total (the share its normal force carries; what moves the CoM)
+//!   is internal, `e = f_left − s_left (f_left + f_right)`, and the feet give way to it, the left
+//!   by `K e`, the right by `−K e`: their sum, and so the balance, is unchanged.
 //! - **Tilt damping**: the robot rocks on its compliant soles (MuJoCo, JVRC-1: about 4 Hz in
 //!   pitch, 2 Hz in roll, excited by every lift-off and swing), which leg odometry cannot see and
 //!   which swings the ZMP by centimetres. For a body of inertia `I` about the sole on a contact of
@@ -118,6 +126,26 @@ pub(crate) fn force_difference_velocities(
     [-v / 2.0, v / 2.0]
 }
 
+/// The horizontal velocities (left, right; world x, y; m/s) of two feet in contact that relax
+/// the force they push each other with: the part of each foot's horizontal ground force
+/// (`horizontal`, N) beyond its share of their total, shared by normal force (`normal`, N), times
+/// `gain` (m/s per N), at most `max` (m/s). Zero when the feet carry no normal force.
+pub(crate) fn internal_force_velocities(
+    horizontal: [Vector2<f64>; 2],
+    normal: [f64; 2],
+    gain: f64,
+    max: f64,
+) -> [Vector2<f64>; 2] {
+    let total = normal[0] + normal[1];
+    if total <= 0.0 {
+        return [Vector2::zeros(); 2];
+    }
+    let left_share = normal[0].max(0.0) / total;
+    let internal = horizontal[0] - left_share * (horizontal[0] + horizontal[1]);
+    let velocity = bounded(gain * internal, max);
+    [velocity, -velocity]
+}
+
 /// The tilt damping's ankle rotation, kept `K_d θ̇` through the velocity of the feet in contact.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct TiltDamping {
@@ -171,6 +199,45 @@ fn bounded(v: Vector2<f64>, max: f64) -> Vector2<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn feet_pushing_each_other_give_way_and_a_force_that_moves_the_com_does_not() {
+        let (gain, max) = (1e-4, 0.02);
+        // Equal loads, the ground pushing the left foot forward and the right back by 90 N: the
+        // legs push each other apart; each foot moves along its ground force, 9 mm/s.
+        let [left, right] = internal_force_velocities(
+            [Vector2::new(90.0, 0.0), Vector2::new(-90.0, 0.0)],
+            [300.0, 300.0],
+            gain,
+            max,
+        );
+        assert!((left - Vector2::new(0.009, 0.0)).norm() < 1e-12, "{left}");
+        assert_eq!(right, -left);
+        // 100 N forward shared as the normal forces are (3:1) accelerates the CoM: nothing to
+        // relax.
+        let moving = internal_force_velocities(
+            [Vector2::new(75.0, 0.0), Vector2::new(25.0, 0.0)],
+            [450.0, 150.0],
+            gain,
+            max,
+        );
+        assert!(moving.iter().all(|v| v.norm() < 1e-12), "{moving:?}");
+        // Large forces are bounded; unloaded feet get nothing.
+        let [fast, _] = internal_force_velocities(
+            [Vector2::new(0.0, 1e4), Vector2::new(0.0, -1e4)],
+            [300.0, 300.0],
+            gain,
+            max,
+        );
+        assert!((fast.norm() - max).abs() < 1e-12);
+        let unloaded = internal_force_velocities(
+            [Vector2::new(5.0, 0.0), Vector2::new(-5.0, 0.0)],
+            [0.0, 0.0],
+            gain,
+            max,
+        );
+        assert_eq!(unloaded, [Vector2::zeros(); 2]);
+    }
 
     const SOLE: SoleRectangle = SoleRectangle {
         length: 0.2,

@@ -286,6 +286,13 @@ pub struct StabilizerConfig {
     pub force_difference_gain: f64,
     /// Bound on the force-difference velocity (m/s).
     pub force_difference_max_speed: f64,
+    /// Internal-force control in double support: the feet give way horizontally, against each
+    /// other, to the force they push each other with (docs/controller.md, "Internal force").
+    pub internal_force: bool,
+    /// Internal-force gain (m/s per N).
+    pub internal_force_gain: f64,
+    /// Bound on the internal-force velocity (m/s).
+    pub internal_force_max_speed: f64,
     /// Tilt damping: the ankles of the feet in contact turn against the body's tilt rate (IMU),
     /// damping its rocking on the compliant soles.
     pub tilt_damping: bool,
@@ -298,7 +305,8 @@ pub struct StabilizerConfig {
 }
 
 /// JVRC-1's stabilizer: DCM feedback, IMU tilt and the ZMP offset off (each made walks fall,
-/// docs/controller.md "Stabilizer"), foot damping, force difference and tilt damping on.
+/// docs/controller.md "Stabilizer"), foot damping, force difference, internal force and tilt
+/// damping on.
 impl Default for StabilizerConfig {
     fn default() -> Self {
         Self {
@@ -317,6 +325,9 @@ impl Default for StabilizerConfig {
             force_difference: true,
             force_difference_gain: 1e-5,
             force_difference_max_speed: 0.02,
+            internal_force: true,
+            internal_force_gain: 1e-4,
+            internal_force_max_speed: 0.02,
             tilt_damping: true,
             tilt_damping_s: 0.03,
             tilt_rate_filter_s: 0.01,
@@ -668,6 +679,13 @@ impl StabilizerConfig {
             Bound::new("tilt_damping_s", self.tilt_damping_s, 0.0, 1.0),
             Bound::new("tilt_rate_filter_s", self.tilt_rate_filter_s, 1e-4, 1.0),
             Bound::new("tilt_damping_max_rad", self.tilt_damping_max_rad, 0.0, 0.5),
+            Bound::new("internal_force_gain", self.internal_force_gain, 0.0, 0.01),
+            Bound::new(
+                "internal_force_max_speed",
+                self.internal_force_max_speed,
+                0.0,
+                1.0,
+            ),
         ];
         bounds.extend(force_difference_bounds(
             self.force_difference_gain,

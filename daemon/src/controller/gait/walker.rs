@@ -42,7 +42,9 @@ use kinematics::robot::{EndEffector, SoleRectangle};
 use nalgebra::{DVector, Isometry3, UnitQuaternion, Vector2, Vector3};
 
 use super::DynamicPlan;
-use super::compliance::{TiltDamping, distribute, foot_damping, force_difference_velocities};
+use super::compliance::{
+    TiltDamping, distribute, foot_damping, force_difference_velocities, internal_force_velocities,
+};
 use super::elevation::support_elevation;
 use super::footsteps::{FEET, Support, SupportPhase, SwingPlan};
 use super::sensing::{DcmEstimator, TiltRate, pressure_centre, tilted_com};
@@ -722,6 +724,22 @@ impl DynamicWalker {
             );
             self.targets.contact_velocity[0][2] = vl;
             self.targets.contact_velocity[1][2] = vr;
+        }
+        if let (true, [Some(_), Some(_)]) = (config.internal_force, feet) {
+            let horizontal = FEET.map(|f| {
+                let w = &sensors.wrenches[f as usize];
+                Vector2::new(w[0], w[1])
+            });
+            let velocities = internal_force_velocities(
+                horizontal,
+                forces,
+                config.internal_force_gain,
+                config.internal_force_max_speed,
+            );
+            for (velocity, v) in self.targets.contact_velocity.iter_mut().zip(velocities) {
+                velocity[0] = v.x;
+                velocity[1] = v.y;
+            }
         }
         if let (true, Some(imu)) = (config.tilt_damping, &sensors.imu) {
             let rate = self.tilt_rate.update(imu, dt, config.tilt_rate_filter_s);
