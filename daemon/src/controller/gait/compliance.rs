@@ -128,19 +128,21 @@ pub(crate) fn force_difference_velocities(
 
 /// The horizontal velocities (left, right; world x, y; m/s) of two feet in contact that relax
 /// the force they push each other with: the part of each foot's horizontal ground force
-/// (`horizontal`, N) beyond its share of their total, shared by normal force (`normal`, N), times
-/// `gain` (m/s per N), at most `max` (m/s). Zero when the feet carry no normal force.
+/// (`horizontal`, N) beyond its share of their total, shared by normal force (`normal`, N; a
+/// negative reading counts as none), times `gain` (m/s per N), at most `max` (m/s). Zero when the
+/// feet carry no normal force.
 pub(crate) fn internal_force_velocities(
     horizontal: [Vector2<f64>; 2],
     normal: [f64; 2],
     gain: f64,
     max: f64,
 ) -> [Vector2<f64>; 2] {
-    let total = normal[0] + normal[1];
+    let [left, right] = normal.map(|n| n.max(0.0));
+    let total = left + right;
     if total <= 0.0 {
         return [Vector2::zeros(); 2];
     }
-    let left_share = normal[0].max(0.0) / total;
+    let left_share = left / total;
     let internal = horizontal[0] - left_share * (horizontal[0] + horizontal[1]);
     let velocity = bounded(gain * internal, max);
     [velocity, -velocity]

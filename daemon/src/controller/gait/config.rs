@@ -185,8 +185,8 @@ pub const CLIMB_PAST_SINGLE_SUPPORT_FACTOR: f64 = 0.85 / 0.55;
 
 /// A double support between two stairs climbed past the other foot, relative to a flat step's,
 /// unless configured (see [`CLIMB_PAST_SINGLE_SUPPORT_FACTOR`]): JVRC-1's 0.35 s with 0.85 s of
-/// single support, 1.2 s a stair. Toe-off takes the last `toe_off_s` of it; over 0.3 s of a
-/// 0.35 s support the climb tipped (7/10), over 0.25 s it walks.
+/// single support, 1.2 s a stair. Toe-off takes the last `toe_off_s` of it: over 0.3 s of a
+/// 0.35 s support the climb walked 7/10, over 0.25 s 30/30.
 pub const CLIMB_PAST_DOUBLE_SUPPORT_FACTOR: f64 = 0.35 / 0.25;
 
 /// A double support next to a stair climbed, relative to a flat step's, unless configured

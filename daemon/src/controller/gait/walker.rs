@@ -688,8 +688,8 @@ impl DynamicWalker {
         };
     }
 
-    /// Foot damping, force difference and tilt damping as contact velocities for the desired ZMP
-    /// `zmp`.
+    /// Foot damping, force difference, internal force and tilt damping as contact velocities for
+    /// the desired ZMP `zmp`.
     fn comply(&mut self, zmp: Vector2<f64>, sensors: &Sensors, ground: f64, dt: f64) {
         let config = self.plan().config.stabilizer;
         self.targets.contact_velocity = [[0.0; 6]; 2];
