@@ -7,8 +7,8 @@
 //!   one `initial_double_support_s`, so the CoM can start from rest, and one next to a step up
 //!   or down (after its touchdown or before its lift-off) `step_double_support_s`, next to a
 //!   stair climbed (level soles) with no other step on its other side `climb_double_support_s`,
-//!   and between stairs climbed past the other foot (one foot per stair)
-//!   `climb_past_double_support_s`;
+//!   and between stairs taken past the other foot (one foot per stair, up or down)
+//!   `past_double_support_s`;
 //! - a foot added (single → double support): the single-support phase in which it swings, from
 //!   lift-off through the highest post-processed swing pose of its flight to its contact pose;
 //!   it lasts `single_support_s` (a stair climbed: `climb_single_support_s`, past the other
@@ -308,9 +308,9 @@ impl Builder<'_> {
     /// support's previous phase, if all timed, else `double_support_s`; the first lift-off from
     /// standing no shorter than `initial_double_support_s` (the CoM starts from rest), and one
     /// after a step up or down or before one (`step_ahead`) no shorter than
-    /// `climb_past_double_support()` when each is level or a stair climbed past the other foot,
-    /// `climb_double_support()` when each is level or a stair climbed, else
-    /// `step_double_support()`.
+    /// `past_double_support()` when each is level or a stair taken past the other foot (up or
+    /// down), `climb_double_support()` when each is level or a stair climbed (past the other foot
+    /// or not), else `step_double_support()`.
     fn lift_off_double_support(&mut self, step_ahead: Rise) -> (f64, PhaseTiming) {
         let limits = self.timing.timed_double_support();
         let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
@@ -321,7 +321,7 @@ impl Builder<'_> {
             } else if sides.contains(&Rise::Stair) {
                 self.timing.climb_double_support()
             } else {
-                self.timing.climb_past_double_support()
+                self.timing.past_double_support()
             };
             timed(dwell, step, limits, step)
         } else if self.stepped {
@@ -347,9 +347,9 @@ impl Builder<'_> {
         let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
         let step = match Rise::of(lift_off, landing, standing) {
             Rise::Level => return timed(dwell, self.timing.single_support_s, limits, 0.0),
-            Rise::StairPast => self.timing.climb_past_single_support(),
+            Rise::ClimbPast => self.timing.climb_past_single_support(),
             Rise::Stair => self.timing.climb_single_support(),
-            Rise::Step => self.timing.step_single_support(),
+            Rise::Step | Rise::DescentPast => self.timing.step_single_support(),
         };
         timed(dwell, step, limits, step)
     }
@@ -415,8 +415,11 @@ enum Rise {
     /// Up from a level sole to a level sole: a stair climbed (`climb_*` timing).
     Stair,
     /// A stair climbed past the foot standing: from below it to above it, one foot per stair
-    /// (`climb_past_*` timing).
-    StairPast,
+    /// (`climb_past_single_support_s`, `past_double_support_s`).
+    ClimbPast,
+    /// A stair descended past the foot standing: from above it to below it, level soles, one
+    /// foot per stair (`step_single_support_s`, `past_double_support_s`).
+    DescentPast,
     /// Any other step: down, or up or onto a slope (`step_*` timing).
     Step,
 }
@@ -435,31 +438,30 @@ impl Rise {
         let level = |pose: &Isometry3<f64>| {
             (pose.rotation * Vector3::z()).angle(&Vector3::z()) < LEVEL_SOLE_RAD
         };
+        let past = standing.is_some_and(|s| passes(lift_off, landing, s));
         if rise.abs() <= STEP_HEIGHT_M {
             Self::Level
-        } else if rise > 0.0 && level(lift_off) && level(landing) {
-            if standing.is_some_and(|s| climbs_past(lift_off, landing, s)) {
-                Self::StairPast
-            } else {
-                Self::Stair
-            }
+        } else if !(level(lift_off) && level(landing)) {
+            Self::Step
+        } else if rise > 0.0 {
+            if past { Self::ClimbPast } else { Self::Stair }
+        } else if past {
+            Self::DescentPast
         } else {
             Self::Step
         }
     }
 }
 
-/// Whether a swing from `lift_off` to `landing` climbs past the foot standing at `standing`: it
-/// lifts off more than [`STEP_HEIGHT_M`] below that foot and lands more than that above it, one
-/// foot per stair.
-fn climbs_past(
-    lift_off: &Isometry3<f64>,
-    landing: &Isometry3<f64>,
-    standing: &Isometry3<f64>,
-) -> bool {
+/// Whether a swing from `lift_off` to `landing` passes the foot standing at `standing`, one foot
+/// per stair: the standing sole is more than [`STEP_HEIGHT_M`] above one end and below the other.
+fn passes(lift_off: &Isometry3<f64>, landing: &Isometry3<f64>, standing: &Isometry3<f64>) -> bool {
     let height = standing.translation.z;
-    lift_off.translation.z < height - STEP_HEIGHT_M
-        && landing.translation.z > height + STEP_HEIGHT_M
+    let [low, high] = {
+        let (a, b) = (lift_off.translation.z, landing.translation.z);
+        [a.min(b), b.max(a)]
+    };
+    low < height - STEP_HEIGHT_M && high > height + STEP_HEIGHT_M
 }
 
 /// Index of a foot in the `[_; 2]` arrays.
@@ -547,40 +549,70 @@ mod tests {
         assert!(timing.climb_single_support() > timing.single_support_s);
     }
 
-    #[test]
-    fn a_stair_climbed_past_the_other_foot_takes_the_climb_past_supports() {
-        let timing = DynamicGaitConfig::default();
-        // One foot per 0.10 m stair: the left onto the first tread, beside the right on the
-        // floor; then each foot from the tread below the other's to the one above it.
-        let stances = [
+    /// One foot per stair of `riser` (m; negative: down): the left onto the first tread, beside
+    /// the right; then each foot from the tread beyond the other's to the one past it. Each
+    /// swing's apex is 3 cm above the higher of its ends.
+    fn one_foot_per_stair(riser: f64) -> [PreparedStance; 7] {
+        let apex = |a: f64, b: f64| a.max(b) + 0.03;
+        [
             stance(DS, standing()[0], standing()[1]),
-            stance(LEFT_UP, at(0.15, 0.1, 0.13), standing()[1]),
-            stance(DS, at(0.3, 0.1, 0.1), standing()[1]),
-            stance(RIGHT_UP, at(0.3, 0.1, 0.1), at(0.3, -0.1, 0.23)),
-            stance(DS, at(0.3, 0.1, 0.1), at(0.6, -0.1, 0.2)),
-            stance(LEFT_UP, at(0.6, 0.1, 0.33), at(0.6, -0.1, 0.2)),
-            stance(DS, at(0.9, 0.1, 0.3), at(0.6, -0.1, 0.2)),
-        ];
-        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+            stance(LEFT_UP, at(0.15, 0.1, apex(0.0, riser)), standing()[1]),
+            stance(DS, at(0.3, 0.1, riser), standing()[1]),
+            stance(
+                RIGHT_UP,
+                at(0.3, 0.1, riser),
+                at(0.3, -0.1, apex(0.0, 2.0 * riser)),
+            ),
+            stance(DS, at(0.3, 0.1, riser), at(0.6, -0.1, 2.0 * riser)),
+            stance(
+                LEFT_UP,
+                at(0.6, 0.1, apex(riser, 3.0 * riser)),
+                at(0.6, -0.1, 2.0 * riser),
+            ),
+            stance(DS, at(0.9, 0.1, 3.0 * riser), at(0.6, -0.1, 2.0 * riser)),
+        ]
+    }
+
+    /// The double supports of [`one_foot_per_stair`]'s plan: the first lift-off's, the one
+    /// `beside` the first stair (taken next to the other foot), then between two stairs taken past
+    /// the other foot, and the final rest.
+    fn past_doubles(timing: &DynamicGaitConfig, beside: f64) -> [f64; 4] {
+        [
+            timing.initial_double_support_s,
+            beside,
+            timing.past_double_support(),
+            timing.final_double_support_s,
+        ]
+    }
+
+    #[test]
+    fn a_stair_climbed_past_the_other_foot_takes_the_past_supports() {
+        let timing = DynamicGaitConfig::default();
+        let plan = FootstepPlan::new(&one_foot_per_stair(0.1), standing(), &timing).unwrap();
         let past = timing.climb_past_single_support();
         assert_eq!(
             durations(&plan, true),
             [timing.climb_single_support(), past, past]
         );
         assert!(past > timing.climb_single_support());
-        // Between the first stair (beside the other foot) and a climb past it: the climb's
-        // double support; between two climbs past: the shorter one of its own.
-        let between = timing.climb_past_double_support();
         assert_eq!(
             durations(&plan, false),
-            [
-                timing.initial_double_support_s,
-                timing.climb_double_support(),
-                between,
-                timing.final_double_support_s
-            ]
+            past_doubles(&timing, timing.climb_double_support())
         );
-        assert!(between < timing.climb_double_support());
+        assert!(timing.past_double_support() < timing.climb_double_support());
+    }
+
+    #[test]
+    fn a_stair_descended_past_the_other_foot_takes_the_past_double_support() {
+        let timing = DynamicGaitConfig::default();
+        let plan = FootstepPlan::new(&one_foot_per_stair(-0.1), standing(), &timing).unwrap();
+        let step = timing.step_single_support();
+        assert_eq!(durations(&plan, true), [step, step, step]);
+        assert_eq!(
+            durations(&plan, false),
+            past_doubles(&timing, timing.step_double_support())
+        );
+        assert!(timing.past_double_support() < timing.step_double_support());
     }
 
     #[test]
