@@ -457,11 +457,8 @@ impl Rise {
 /// per stair: the standing sole is more than [`STEP_HEIGHT_M`] above one end and below the other.
 fn passes(lift_off: &Isometry3<f64>, landing: &Isometry3<f64>, standing: &Isometry3<f64>) -> bool {
     let height = standing.translation.z;
-    let [low, high] = {
-        let (a, b) = (lift_off.translation.z, landing.translation.z);
-        [a.min(b), b.max(a)]
-    };
-    low < height - STEP_HEIGHT_M && high > height + STEP_HEIGHT_M
+    let (a, b) = (lift_off.translation.z, landing.translation.z);
+    a.min(b) < height - STEP_HEIGHT_M && a.max(b) > height + STEP_HEIGHT_M
 }
 
 /// Index of a foot in the `[_; 2]` arrays.
