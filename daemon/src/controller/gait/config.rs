@@ -62,7 +62,8 @@ pub struct DynamicGaitConfig {
     /// [`CLIMB_DOUBLE_SUPPORT_FACTOR`] × `double_support_s`.
     pub climb_double_support_s: Option<f64>,
     /// Duration of a double support between two stairs taken past the other foot, one foot per
-    /// stair, up or down (or next to one, with a level step on its other side), in place of
+    /// stair, up or down (or next to one, with a level step on its other side), and of the one
+    /// before the first stair climbed past the other foot after one climbed beside it, in place of
     /// `climb_double_support_s` / `step_double_support_s` (s); absent:
     /// [`PAST_DOUBLE_SUPPORT_FACTOR`] × `double_support_s`.
     pub past_double_support_s: Option<f64>,
@@ -188,7 +189,9 @@ pub const CLIMB_PAST_SINGLE_SUPPORT_FACTOR: f64 = 0.85 / 0.55;
 /// single support (see [`CLIMB_PAST_SINGLE_SUPPORT_FACTOR`]), 1.2 s a stair; toe-off takes the
 /// last `toe_off_s` of it: over 0.3 s of a 0.35 s support the climb walked 7/10, over 0.25 s
 /// 30/30. Descending the 0.10 m stairs with the step's 1.1 s single support (in process, seeds
-/// 0–9) 10/10 at 0.3, 0.4, 0.5 and 0.6 s (the step's 0.8 s before), 4/10 at 0.2 s.
+/// 0–9) 10/10 at 0.3, 0.4, 0.5 and 0.6 s (the step's 0.8 s before), 4/10 at 0.2 s. Before the
+/// first stair climbed past the other foot too (the climb's 0.45 s before): 60/60 up the 0.10 m
+/// stairs, 1.20 s a stair (median over the processes, 1.21–1.22 s before).
 pub const PAST_DOUBLE_SUPPORT_FACTOR: f64 = 0.35 / 0.25;
 
 /// A double support next to a stair climbed, relative to a flat step's, unless configured

@@ -309,8 +309,9 @@ impl Builder<'_> {
     /// standing no shorter than `initial_double_support_s` (the CoM starts from rest), and one
     /// after a step up or down or before one (`step_ahead`) no shorter than
     /// `past_double_support()` when each is level or a stair taken past the other foot (up or
-    /// down), `climb_double_support()` when each is level or a stair climbed (past the other foot
-    /// or not), else `step_double_support()`.
+    /// down), or the step ahead is a stair climbed past it after one climbed beside it,
+    /// `climb_double_support()` when each is level or a stair climbed (past the other foot or
+    /// not), else `step_double_support()`.
     fn lift_off_double_support(&mut self, step_ahead: Rise) -> (f64, PhaseTiming) {
         let limits = self.timing.timed_double_support();
         let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
@@ -318,7 +319,7 @@ impl Builder<'_> {
         if self.stepped && sides.iter().any(|r| *r != Rise::Level) {
             let step = if sides.contains(&Rise::Step) {
                 self.timing.step_double_support()
-            } else if sides.contains(&Rise::Stair) {
+            } else if sides.contains(&Rise::Stair) && step_ahead != Rise::ClimbPast {
                 self.timing.climb_double_support()
             } else {
                 self.timing.past_double_support()
@@ -592,9 +593,11 @@ mod tests {
             [timing.climb_single_support(), past, past]
         );
         assert!(past > timing.climb_single_support());
+        // The double support before the first stair climbed past the other foot is a past one
+        // too: its feet stand one riser apart, as between any two.
         assert_eq!(
             durations(&plan, false),
-            past_doubles(&timing, timing.climb_double_support())
+            past_doubles(&timing, timing.past_double_support())
         );
         assert!(timing.past_double_support() < timing.climb_double_support());
     }
