@@ -315,6 +315,33 @@ fn a_robot_without_a_dynamic_gait_refuses_a_dynamic_walk() {
     assert_eq!(prepared.gait(), Gait::Static);
 }
 
+/// A step-down ZMP set beyond the sole's front edge is refused before anything moves, naming the
+/// key and the sole.
+#[test]
+fn a_step_down_zmp_beyond_the_sole_is_refused() {
+    let h = Harness::new("jvrc1", 500.0);
+    let sequence = synthetic_walk(&h.robot, 2, 0.1, false);
+    let mut gaits = kinematic_gait_config("jvrc1");
+    gaits
+        .dynamic
+        .as_mut()
+        .expect("jvrc1 has a dynamic gait")
+        .step_down_zmp_forward_m = 0.15;
+    let Err(Refusal(reason)) = Controller::prepare_gait(
+        &h.robot,
+        &controller_config("jvrc1"),
+        &gaits,
+        &sequence,
+        Gait::Dynamic,
+    ) else {
+        panic!("a step-down ZMP 0.15 m ahead on a 0.2 m sole was accepted");
+    };
+    assert!(
+        reason.contains("step_down_zmp_forward_m") && reason.contains("0.2 m long sole"),
+        "{reason}"
+    );
+}
+
 /// A stance file of format version 1 (written before stances had durations; the flat JVRC-1
 /// walk of `stance/tests/data`) still loads, and the dynamic gait walks it on the config's
 /// timing.

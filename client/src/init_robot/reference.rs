@@ -89,7 +89,7 @@ pub const CONTROLLER: [(&str, Tuned); 45] = [
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic]`, in its order.
-pub const GAIT_DYNAMIC: [(&str, Tuned); 19] = [
+pub const GAIT_DYNAMIC: [(&str, Tuned); 20] = [
     ("single_support_s", Tuned::Number(0.55)),
     ("double_support_s", Tuned::Number(0.25)),
     ("initial_double_support_s", Tuned::Number(1.0)),
@@ -109,6 +109,7 @@ pub const GAIT_DYNAMIC: [(&str, Tuned); 19] = [
     ("max_slope_rad", Tuned::Number(0.27)),
     ("toe_off_rad", Tuned::Number(0.5)),
     ("toe_off_s", Tuned::Number(0.25)),
+    ("step_down_zmp_forward_m", Tuned::Number(0.03)),
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic.stabilizer]`, in its order.

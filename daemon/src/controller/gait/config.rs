@@ -57,6 +57,11 @@ pub struct DynamicGaitConfig {
     /// treads), in place of `climb_single_support_s` (s); absent:
     /// [`CLIMB_PAST_SINGLE_SUPPORT_FACTOR`] × `single_support_s`.
     pub climb_past_single_support_s: Option<f64>,
+    /// Duration of the single support of a stair descended past the other foot, one foot per
+    /// stair (from the tread above the standing foot's to the one below it), in place of
+    /// `step_single_support_s` (s); absent: [`DESCENT_PAST_SINGLE_SUPPORT_FACTOR`] ×
+    /// `single_support_s`.
+    pub descent_past_single_support_s: Option<f64>,
     /// Duration of a double support next to a stair climbed with no other step up or down on
     /// its other side, in place of `step_double_support_s` (s); absent:
     /// [`CLIMB_DOUBLE_SUPPORT_FACTOR`] × `double_support_s`.
@@ -121,6 +126,11 @@ pub struct DynamicGaitConfig {
     /// roll range is small cannot tilt its legs far enough to sway the CoM out to the sole
     /// centres; a ZMP nearer the midline shrinks the lateral sway by the same fraction.
     pub zmp_inward_offset_m: f64,
+    /// In a single support whose swing lands lower than the stance sole (a step down: a stair,
+    /// a ramp), the ZMP reference sits this far ahead of the stance sole's centre, along the
+    /// sole (m; 0: on the centre). The standing knee lowers the body bent ahead of the ankle;
+    /// a ZMP ahead of the ankle shortens the knee's lever (docs/controller.md, "Swing").
+    pub step_down_zmp_forward_m: f64,
     /// Replaces `[controller] posture_weight` on the torso joints (`[robot.joint_groups] torso`)
     /// in the dynamic gait. At the posture weight the QP keeps a held hand in place largely with
     /// the waist, whose long lever makes it cheap: the upper body swung round and sideways while
@@ -184,6 +194,19 @@ pub const CLIMB_SINGLE_SUPPORT_FACTOR: f64 = 0.75 / 0.55;
 /// 0.75 s 3–4 of 10.
 pub const CLIMB_PAST_SINGLE_SUPPORT_FACTOR: f64 = 0.85 / 0.55;
 
+/// A stair descended past the other foot (one foot per stair), relative to a flat step's single
+/// support, unless configured. JVRC-1 down the 0.10 m stairs under MuJoCo (in process, with the
+/// ZMP 0.03 m ahead, [`STEP_DOWN_ZMP_FORWARD_M`]): 0.95 s 50/50 (seeds 0–49), 0.9 s 77/80,
+/// 1.0 s 10/10; without the ZMP ahead 0.9 s 0/10, and at the step's 1.1 s a knee held its torque
+/// limit for twice as long.
+pub const DESCENT_PAST_SINGLE_SUPPORT_FACTOR: f64 = 0.95 / 0.55;
+
+/// `step_down_zmp_forward_m` unless configured: JVRC-1's. Its descents of the 0.10 m stairs at
+/// 0.9 s of single support (in process, seeds 0–9) walked 10/10 at 0.02–0.04 m, 8/10 at 0.05 m and
+/// 0/10 at 0; the same offset climbing (the swing landing higher) failed the 0.10 m climb, 0/10,
+/// an ankle at its torque limit, so it is for steps down only.
+pub const STEP_DOWN_ZMP_FORWARD_M: f64 = 0.03;
+
 /// A double support between two stairs taken past the other foot (one foot per stair, up or
 /// down), relative to a flat step's, unless configured: JVRC-1's 0.35 s. Climbing, with 0.85 s of
 /// single support (see [`CLIMB_PAST_SINGLE_SUPPORT_FACTOR`]), 1.2 s a stair; toe-off takes the
@@ -222,6 +245,7 @@ impl Default for DynamicGaitConfig {
             step_double_support_s: None,
             climb_single_support_s: None,
             climb_past_single_support_s: None,
+            descent_past_single_support_s: None,
             climb_double_support_s: None,
             past_double_support_s: None,
             initial_double_support_s: 1.0,
@@ -239,6 +263,7 @@ impl Default for DynamicGaitConfig {
             hand_weight: Some(0.02),
             com_gain: Some(DYNAMIC_COM_GAIN),
             zmp_inward_offset_m: 0.0,
+            step_down_zmp_forward_m: STEP_DOWN_ZMP_FORWARD_M,
             torso_posture_weight: Some(1.0),
             max_step_up_m: 0.15,
             max_step_down_m: 0.15,
@@ -487,6 +512,13 @@ impl DynamicGaitConfig {
             .unwrap_or(CLIMB_PAST_SINGLE_SUPPORT_FACTOR * self.single_support_s)
     }
 
+    /// The single support of a stair descended past the other foot
+    /// (`descent_past_single_support_s` or its default).
+    pub fn descent_past_single_support(&self) -> f64 {
+        self.descent_past_single_support_s
+            .unwrap_or(DESCENT_PAST_SINGLE_SUPPORT_FACTOR * self.single_support_s)
+    }
+
     /// The double support next to a stair climbed (`climb_double_support_s` or its default).
     pub fn climb_double_support(&self) -> f64 {
         self.climb_double_support_s
@@ -585,6 +617,12 @@ impl DynamicGaitConfig {
                 5.0,
             ),
             Bound::optional(
+                "descent_past_single_support_s",
+                self.descent_past_single_support_s,
+                0.1,
+                5.0,
+            ),
+            Bound::optional(
                 "climb_double_support_s",
                 self.climb_double_support_s,
                 0.01,
@@ -624,6 +662,12 @@ impl DynamicGaitConfig {
             Bound::optional("hand_weight", self.hand_weight, 1e-6, 1e6),
             Bound::optional("com_gain", self.com_gain, 0.01, 1000.0),
             Bound::new("zmp_inward_offset_m", self.zmp_inward_offset_m, 0.0, 0.2),
+            Bound::new(
+                "step_down_zmp_forward_m",
+                self.step_down_zmp_forward_m,
+                0.0,
+                0.2,
+            ),
             Bound::optional("torso_posture_weight", self.torso_posture_weight, 1e-6, 1e6),
             Bound::new("max_step_up_m", self.max_step_up_m, 0.0, 1.0),
             Bound::new("max_step_down_m", self.max_step_down_m, 0.0, 1.0),
@@ -809,6 +853,7 @@ mod tests {
             ("gait.dynamic", "step_double_support_s"),
             ("gait.dynamic", "climb_single_support_s"),
             ("gait.dynamic", "climb_past_single_support_s"),
+            ("gait.dynamic", "descent_past_single_support_s"),
             ("gait.dynamic", "climb_double_support_s"),
             ("gait.dynamic", "past_double_support_s"),
             ("gait.dynamic", "initial_double_support_s"),

@@ -6,7 +6,8 @@
 //! part: `ċ = ω (ξ − c)` and `ξ̇ = ω (ξ − p)` (Englsberger et al. 2015).
 //!
 //! The ZMP reference stays at the stance foot's sole centre in single support (or moved inwards,
-//! towards the other foot, by `zmp_inward_offset_m`) and crosses to the next stance foot over the double supports between two steps, from the start point to the
+//! towards the other foot, by `zmp_inward_offset_m`, and ahead by `step_down_zmp_forward_m` while
+//! the swing steps down: [`ZmpOffsets`]) and crosses to the next stance foot over the double supports between two steps, from the start point to the
 //! first stance foot over the initial double support, and from the last one to the centre of the
 //! final feet over the final double support. A crossing follows the minimum-jerk profile
 //! (`TRANSFER_PIECES` linear pieces through it): a ZMP that left a foot in a straight line would
@@ -26,9 +27,10 @@
 //! in `q`): the ZMP first moves away from the first stance foot, which starts the CoM towards it.
 
 use kinematics::robot::EndEffector;
-use nalgebra::{Isometry3, Point3, Vector2};
+use nalgebra::{Isometry3, Point3, Vector2, Vector3};
 
 use super::footsteps::{FEET, Support, SupportPhase};
+use crate::controller::machine::STEP_HEIGHT_M;
 use crate::controller::trajectory::Profile;
 
 /// One linear piece of the ZMP reference and the DCM at its end.
@@ -89,10 +91,10 @@ pub(crate) struct DcmPattern {
 
 impl DcmPattern {
     /// The pattern of `phases` (back to back from time 0) for a pendulum of natural frequency
-    /// `omega` (1/s), the single supports' ZMP `inward` (m) from the stance sole's centre
-    /// towards the other foot. It starts from the centre of the first phase's feet until
-    /// [`start_at_rest`](Self::start_at_rest) sets the start point.
-    pub fn new(phases: &[SupportPhase], omega: f64, inward: f64) -> Self {
+    /// `omega` (1/s), the single supports' ZMP `offsets` from the stance sole's centre. It starts
+    /// from the centre of the first phase's feet until [`start_at_rest`](Self::start_at_rest)
+    /// sets the start point.
+    pub fn new(phases: &[SupportPhase], omega: f64, offsets: ZmpOffsets) -> Self {
         let first = phases.first().expect("a plan has phases");
         let last = phases.last().expect("a plan has phases");
         let rest = feet_centre(&last.feet);
@@ -103,14 +105,14 @@ impl DcmPattern {
         // The ZMP where the double supports since the last single support began, and when.
         let mut crossing = (feet_centre(&first.feet), 0.0);
         for phase in phases {
-            if let Support::Single(_) = phase.support {
+            if let Support::Single(swing) = &phase.support {
                 let (foot, stance) = phase
                     .feet
                     .iter()
                     .enumerate()
                     .find_map(|(f, pose)| pose.map(|pose| (f, pose)))
                     .expect("single support stands on a foot");
-                let on_stance = stance_zmp(&stance, FEET[foot], inward);
+                let on_stance = single_support_zmp(&stance, FEET[foot], &swing.landing, offsets);
                 push_crossing(&mut segments, crossing, (on_stance, phase.start_s));
                 push_piece(
                     &mut segments,
@@ -308,6 +310,34 @@ fn minimum_jerk(tau: f64) -> f64 {
     Profile::MinimumJerk.sample(tau, 1.0).0
 }
 
+/// Where the single supports' ZMP reference sits on the stance sole, from its centre.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct ZmpOffsets {
+    /// Towards the other foot along the sole's lateral axis (m): `zmp_inward_offset_m`.
+    pub inward: f64,
+    /// Ahead along the sole's forward axis while the swing lands more than [`STEP_HEIGHT_M`]
+    /// below the stance sole (m): `step_down_zmp_forward_m`.
+    pub step_down_forward: f64,
+}
+
+/// The single support's ZMP on the stance sole `pose` of `foot` while the swing lands at
+/// `landing`: [`stance_zmp`] with `offsets.inward`, and on a step down `offsets.step_down_forward`
+/// ahead along the sole. The standing knee lowers the body bent ahead of the ankle, and a ZMP
+/// ahead shortens its lever: JVRC-1's knee held its torque limit for half as long.
+fn single_support_zmp(
+    pose: &Isometry3<f64>,
+    foot: EndEffector,
+    landing: &Isometry3<f64>,
+    offsets: ZmpOffsets,
+) -> Vector2<f64> {
+    let on_stance = stance_zmp(pose, foot, offsets.inward);
+    if landing.translation.z < pose.translation.z - STEP_HEIGHT_M {
+        on_stance + (pose.rotation * Vector3::x()).xy() * offsets.step_down_forward
+    } else {
+        on_stance
+    }
+}
+
 /// The single support's ZMP on the stance sole `pose` of `foot`: `inward` (m) from its centre
 /// along the sole's lateral axis, towards the other foot (the left foot's right, the right
 /// foot's left).
@@ -354,6 +384,11 @@ mod tests {
 
     /// A four-step walk, 0.2 m per step, feet 0.19 m apart.
     fn plan() -> FootstepPlan {
+        plan_down(0.0)
+    }
+
+    /// [`plan`] with each landing `drop` (m) below the foot standing, one foot per stair.
+    fn plan_down(drop: f64) -> FootstepPlan {
         let (left, right) = (0.095, -0.095);
         let mut feet = [at(0.0, left, 0.0), at(0.0, right, 0.0)];
         let stance = |contacts: [bool; 4], feet: [Isometry3<f64>; 2]| {
@@ -377,6 +412,7 @@ mod tests {
             contacts[slot] = false;
             stances.push(stance(contacts, air));
             feet[slot].translation.x += 0.2 + if step == 0 { -0.1 } else { 0.0 };
+            feet[slot].translation.z = -drop * (step + 1) as f64;
             stances.push(stance([true, true, false, false], feet));
         }
         // Fixed timing, not the defaults: the closed-form check's RK4 error grows with the
@@ -391,7 +427,7 @@ mod tests {
 
     fn pattern() -> (FootstepPlan, DcmPattern) {
         let plan = plan();
-        let mut pattern = DcmPattern::new(&plan.phases, OMEGA, 0.0);
+        let mut pattern = DcmPattern::new(&plan.phases, OMEGA, ZmpOffsets::default());
         pattern.start_at_rest(Vector2::new(0.01, 0.0));
         (plan, pattern)
     }
@@ -499,7 +535,12 @@ mod tests {
     fn an_inward_offset_moves_the_single_support_zmp_towards_the_other_foot() {
         let plan = plan();
         let inward = 0.03;
-        let mut pattern = DcmPattern::new(&plan.phases, OMEGA, inward);
+        let offsets = ZmpOffsets {
+            inward,
+            step_down_forward: 0.05,
+        };
+        // Level steps: the step-down offset does not apply.
+        let mut pattern = DcmPattern::new(&plan.phases, OMEGA, offsets);
         pattern.start_at_rest(Vector2::new(0.01, 0.0));
         let mut cursor = 0;
         let mut singles = 0;
@@ -526,6 +567,29 @@ mod tests {
         // The pattern still ends at rest on the final feet's centre.
         let end = pattern.sample(plan.duration_s(), &mut 0);
         assert!((end.dcm - pattern.rest()).norm() < 1e-12);
+    }
+
+    #[test]
+    fn a_step_down_moves_the_single_support_zmp_ahead_on_the_stance_sole() {
+        let plan = plan_down(0.1);
+        let offsets = ZmpOffsets {
+            inward: 0.0,
+            step_down_forward: 0.03,
+        };
+        let pattern = DcmPattern::new(&plan.phases, OMEGA, offsets);
+        let mut cursor = 0;
+        let mut singles = 0;
+        for phase in &plan.phases {
+            if let Support::Single(_) = phase.support {
+                singles += 1;
+                let foot = phase.feet.iter().flatten().next().unwrap();
+                let middle = pattern.sample(phase.start_s + phase.duration_s / 2.0, &mut cursor);
+                // The soles face +x.
+                let ahead = foot.translation.vector.xy() + Vector2::new(0.03, 0.0);
+                assert!((middle.zmp - ahead).norm() < 1e-12, "{:?}", middle.zmp);
+            }
+        }
+        assert_eq!(singles, 4);
     }
 
     #[test]

@@ -12,8 +12,8 @@
 //! - a foot added (single → double support): the single-support phase in which it swings, from
 //!   lift-off through the highest post-processed swing pose of its flight to its contact pose;
 //!   it lasts `single_support_s` (a stair climbed: `climb_single_support_s`, past the other
-//!   foot, one foot per stair: `climb_past_single_support_s`; any other step up or down:
-//!   `step_single_support_s`);
+//!   foot, one foot per stair: `climb_past_single_support_s`; a stair descended past the other
+//!   foot: `descent_past_single_support_s`; any other step up or down: `step_single_support_s`);
 //! - a foot added and the other released at once (single support on one foot, then on the
 //!   other): that swing, then a double support of `double_support_s` before the lift-off;
 //! - only hands change: a double support of `hand_transition_s` while they reach;
@@ -336,8 +336,9 @@ impl Builder<'_> {
     /// The single support of a swing from `lift_off` to `landing` while the other foot stands
     /// at `standing`: the stances its foot was in the air, if all timed, else
     /// `single_support_s`; a stair climbed no shorter than `climb_single_support()` (past the
-    /// standing foot, one foot per stair: `climb_past_single_support()`), any other step up or
-    /// down no shorter than `step_single_support()`.
+    /// standing foot, one foot per stair: `climb_past_single_support()`), a stair descended past
+    /// it no shorter than `descent_past_single_support()`, any other step up or down no shorter
+    /// than `step_single_support()`.
     fn swing_single_support(
         &mut self,
         lift_off: &Isometry3<f64>,
@@ -350,7 +351,8 @@ impl Builder<'_> {
             Rise::Level => return timed(dwell, self.timing.single_support_s, limits, 0.0),
             Rise::ClimbPast => self.timing.climb_past_single_support(),
             Rise::Stair => self.timing.climb_single_support(),
-            Rise::Step | Rise::DescentPast => self.timing.step_single_support(),
+            Rise::DescentPast => self.timing.descent_past_single_support(),
+            Rise::Step => self.timing.step_single_support(),
         };
         timed(dwell, step, limits, step)
     }
@@ -419,7 +421,7 @@ enum Rise {
     /// (`climb_past_single_support_s`, `past_double_support_s`).
     ClimbPast,
     /// A stair descended past the foot standing: from above it to below it, level soles, one
-    /// foot per stair (`step_single_support_s`, `past_double_support_s`).
+    /// foot per stair (`descent_past_single_support_s`, `past_double_support_s`).
     DescentPast,
     /// Any other step: down, or up or onto a slope (`step_*` timing).
     Step,
@@ -603,11 +605,15 @@ mod tests {
     }
 
     #[test]
-    fn a_stair_descended_past_the_other_foot_takes_the_past_double_support() {
+    fn a_stair_descended_past_the_other_foot_takes_the_past_supports() {
         let timing = DynamicGaitConfig::default();
         let plan = FootstepPlan::new(&one_foot_per_stair(-0.1), standing(), &timing).unwrap();
-        let step = timing.step_single_support();
-        assert_eq!(durations(&plan, true), [step, step, step]);
+        let (step, past) = (
+            timing.step_single_support(),
+            timing.descent_past_single_support(),
+        );
+        assert_eq!(durations(&plan, true), [step, past, past]);
+        assert!(past < step);
         assert_eq!(
             durations(&plan, false),
             past_doubles(&timing, timing.step_double_support())

@@ -35,7 +35,7 @@ pub use config::{DynamicGaitConfig, GaitConfig, StabilizerConfig};
 pub(crate) use walker::{DynamicWalker, Sensors};
 
 use super::sequence::{PreparedStance, Refusal};
-use dcm::DcmPattern;
+use dcm::{DcmPattern, ZmpOffsets};
 use footsteps::{FEET, FootstepPlan};
 
 /// Everything the dynamic gait computes for a sequence before it runs.
@@ -93,8 +93,20 @@ impl DynamicPlan {
                 robot.sole.width
             )));
         }
+        let forward = config.step_down_zmp_forward_m;
+        if forward > robot.sole.length / 2.0 {
+            return Err(Refusal(format!(
+                "[gait.dynamic] step_down_zmp_forward_m {forward} m puts the single-support ZMP \
+                 of a step down outside the {} m long sole",
+                robot.sole.length
+            )));
+        }
         let omega = (GRAVITY / com_height).sqrt();
-        let pattern = DcmPattern::new(&footsteps.phases, omega, inward);
+        let offsets = ZmpOffsets {
+            inward,
+            step_down_forward: forward,
+        };
+        let pattern = DcmPattern::new(&footsteps.phases, omega, offsets);
         let limits = model.joint_limits();
         let slowest_leg = robot
             .joint_groups
