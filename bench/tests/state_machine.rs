@@ -640,11 +640,11 @@ fn the_estimate_turns_onto_the_imu_heading_no_faster_than_its_bound() {
 /// A stair higher than a gait is set to take (`max_step_up_m`, `max_step_down_m` of
 /// `[controller]` for the static gait, of `[gait.dynamic]` for the dynamic one) is refused
 /// before anything moves, naming the stance, the foot, the height and the key. JVRC-1's dynamic
-/// gait climbs 0.15 m stairs (on its toes) and walks down 0.15 m ones under MuJoCo; up and down
-/// 0.185 m it tipped at the first stair and fell after the fault. A step's height is the riser,
-/// the landing above or below the other foot: one foot per 0.10 m stair, each foot rises 0.20 m
-/// from its last sole, and is taken. Its static gait takes the 10° ramp's steps, not a 0.10 m
-/// stair.
+/// gait climbs 0.15 m stairs (on its toes) and walks down 0.185 m ones under MuJoCo; up 0.185 m
+/// it tipped at the first stair and fell after the fault. ARMAR-4's dynamic gait takes no stair.
+/// A step's height is the riser, the landing above or below the other foot: one foot per
+/// 0.10 m stair, each foot rises 0.20 m from its last sole, and is taken. JVRC-1's static gait
+/// takes the 10° ramp's steps, not a 0.10 m stair.
 #[test]
 fn stairs_higher_than_a_gait_takes_are_refused_naming_the_step_and_the_key() {
     use stance::Gait;
@@ -653,34 +653,39 @@ fn stairs_higher_than_a_gait_takes_are_refused_naming_the_step_and_the_key() {
     assert_eq!(prepare("stairs-up-10cm.toml", Gait::Dynamic), Ok(()));
     assert_eq!(prepare("stairs-down-10cm.toml", Gait::Dynamic), Ok(()));
     assert_eq!(prepare("stairs-down-15cm.toml", Gait::Dynamic), Ok(()));
+    assert_eq!(prepare("stairs-down-18cm.toml", Gait::Dynamic), Ok(()));
     assert_eq!(prepare("ramp-10deg.toml", Gait::Static), Ok(()));
-    for (scene, gait, step, key) in [
+    for (robot, scene, gait, step, key) in [
         (
+            "jvrc1",
             "stairs-up-18cm.toml",
             Gait::Dynamic,
             "steps up 0.185 m",
             "[gait.dynamic] max_step_up_m = 0.15,",
         ),
         (
-            "stairs-down-18cm.toml",
+            "armar4",
+            "stairs-down-10cm.toml",
             Gait::Dynamic,
-            "steps down 0.185 m",
-            "[gait.dynamic] max_step_down_m = 0.15,",
+            "steps down 0.100 m",
+            "[gait.dynamic] max_step_down_m = 0.01,",
         ),
         (
+            "jvrc1",
             "stairs-up-10cm.toml",
             Gait::Static,
             "steps up 0.100 m",
             "[controller] max_step_up_m = 0.06,",
         ),
         (
+            "jvrc1",
             "stairs-down-10cm.toml",
             Gait::Static,
             "steps down 0.100 m",
             "[controller] max_step_down_m = 0.06,",
         ),
     ] {
-        let refusal = prepare(scene, gait).expect_err(scene);
+        let refusal = prepare_on_scene(robot, scene, gait).expect_err(scene);
         assert!(
             refusal.starts_with("sequence refused: stance ")
                 && refusal.contains("foot ")

@@ -7,8 +7,9 @@
 //! lengths scale with r, times and speeds with t):
 //!
 //! - dynamic gait timing: `single_support_s` = 0.55 s·t, `double_support_s` = 0.25 s·t (times k,
-//!   below); `max_step_up_m`, `max_step_down_m` = 0.15 m·r; `step_down_zmp_forward_m` = 0.03 m ×
-//!   sole length / 0.20 m (JVRC-1's share of its sole);
+//!   below); `max_step_up_m`, `max_step_down_m` = (0.15, 0.19) m·r; `step_down_speed` = 0.15
+//!   m/s·t; `step_down_zmp_forward_m` = 0.03 m × sole length / 0.20 m (JVRC-1's share of its
+//!   sole);
 //! - `[postprocess]` (static gait): `s_max` = min(0.24 m·r, 1.2 × sole length); `h_min`,
 //!   `h_max` = (0.03, 0.08) m·r; `scf` keeps JVRC-1's mapping of the human stride onto about
 //!   0.8 `s_max`: the stance generator already scales the human walk by the pelvis height P,
@@ -442,6 +443,14 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
                     name,
                     round(base * r, 0.001),
                     format!("{base} × l/l_ref: higher steps are refused (JVRC-1's, measured)"),
+                )
+            }
+            "step_down_speed" => {
+                let base = reference::number(&reference::GAIT_DYNAMIC, name);
+                key(
+                    name,
+                    round(base * t, 0.001),
+                    format!("{base} m/s × t (JVRC-1's, measured)"),
                 )
             }
             "step_down_zmp_forward_m" => {

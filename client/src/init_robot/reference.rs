@@ -89,7 +89,7 @@ pub const CONTROLLER: [(&str, Tuned); 45] = [
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic]`, in its order.
-pub const GAIT_DYNAMIC: [(&str, Tuned); 20] = [
+pub const GAIT_DYNAMIC: [(&str, Tuned); 21] = [
     ("single_support_s", Tuned::Number(0.55)),
     ("double_support_s", Tuned::Number(0.25)),
     ("initial_double_support_s", Tuned::Number(1.0)),
@@ -105,7 +105,8 @@ pub const GAIT_DYNAMIC: [(&str, Tuned); 20] = [
     ("com_gain", Tuned::Number(3.0)),
     ("torso_posture_weight", Tuned::Number(1.0)),
     ("max_step_up_m", Tuned::Number(0.15)),
-    ("max_step_down_m", Tuned::Number(0.15)),
+    ("max_step_down_m", Tuned::Number(0.19)),
+    ("step_down_speed", Tuned::Number(0.15)),
     ("max_slope_rad", Tuned::Number(0.27)),
     ("toe_off_rad", Tuned::Number(0.5)),
     ("toe_off_s", Tuned::Number(0.25)),

@@ -13,7 +13,8 @@
 //!   lift-off through the highest post-processed swing pose of its flight to its contact pose;
 //!   it lasts `single_support_s` (a stair climbed: `climb_single_support_s`, past the other
 //!   foot, one foot per stair: `climb_past_single_support_s`; a stair descended past the other
-//!   foot: `descent_past_single_support_s`; any other step up or down: `step_single_support_s`);
+//!   foot: `descent_past_single_support_s`; any other step up or down: `step_single_support_s`,
+//!   down no shorter than its drop at `step_down_speed`);
 //! - a foot added and the other released at once (single support on one foot, then on the
 //!   other): that swing, then a double support of `double_support_s` before the lift-off;
 //! - only hands change: a double support of `hand_transition_s` while they reach;
@@ -338,7 +339,7 @@ impl Builder<'_> {
     /// `single_support_s`; a stair climbed no shorter than `climb_single_support()` (past the
     /// standing foot, one foot per stair: `climb_past_single_support()`), a stair descended past
     /// it no shorter than `descent_past_single_support()`, any other step up or down no shorter
-    /// than `step_single_support()`.
+    /// than `step_single_support()` (down, than `step_down_single_support()` of its drop).
     fn swing_single_support(
         &mut self,
         lift_off: &Isometry3<f64>,
@@ -352,7 +353,10 @@ impl Builder<'_> {
             Rise::ClimbPast => self.timing.climb_past_single_support(),
             Rise::Stair => self.timing.climb_single_support(),
             Rise::DescentPast => self.timing.descent_past_single_support(),
-            Rise::Step => self.timing.step_single_support(),
+            Rise::Step => {
+                let drop = lift_off.translation.z - landing.translation.z;
+                self.timing.step_down_single_support(drop)
+            }
         };
         timed(dwell, step, limits, step)
     }
@@ -651,6 +655,21 @@ mod tests {
             ]
         );
         assert!(timing.step_single_support() > timing.climb_single_support());
+    }
+
+    #[test]
+    fn a_deep_step_down_lowers_the_body_no_faster_than_the_step_down_speed() {
+        let timing = DynamicGaitConfig::default();
+        let drop = 0.185;
+        let stances = [
+            stance(DS, standing()[0], standing()[1]),
+            stance(LEFT_UP, at(0.15, 0.1, 0.0), standing()[1]),
+            stance(DS, at(0.3, 0.1, -drop), standing()[1]),
+        ];
+        let plan = FootstepPlan::new(&stances, standing(), &timing).unwrap();
+        let slow = drop / timing.step_down_speed;
+        assert!(slow > timing.step_single_support());
+        assert_eq!(durations(&plan, true), [slow]);
     }
 
     #[test]
