@@ -432,36 +432,30 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
         },
     );
 
+    // JVRC-1's measured value of `name` times `factor`, the rule naming the scale.
+    let scaled = |name: &'static str, factor: f64, scale: &str| {
+        let base = reference::number(&reference::GAIT_DYNAMIC, name);
+        key(
+            name,
+            round(base * factor, 0.001),
+            format!("{base} {scale} (JVRC-1's, measured)"),
+        )
+    };
+    let jvrc1_sole = reference::jvrc1().sole_length_m;
     let mut gait_dynamic = lateral.lines.clone();
     for (name, _) in reference::GAIT_DYNAMIC.iter() {
         gait_dynamic.push(match *name {
             "single_support_s" => key(name, single, period_rule(0.55)),
             "double_support_s" => key(name, double, period_rule(0.25)),
             "max_step_up_m" | "max_step_down_m" => {
-                let base = reference::number(&reference::GAIT_DYNAMIC, name);
-                key(
-                    name,
-                    round(base * r, 0.001),
-                    format!("{base} × l/l_ref: higher steps are refused (JVRC-1's, measured)"),
-                )
+                scaled(name, r, "× l/l_ref: higher steps are refused")
             }
-            "step_down_speed" => {
-                let base = reference::number(&reference::GAIT_DYNAMIC, name);
-                key(
-                    name,
-                    round(base * t, 0.001),
-                    format!("{base} m/s × t (JVRC-1's, measured)"),
-                )
-            }
-            "step_down_zmp_forward_m" => {
-                let base = reference::number(&reference::GAIT_DYNAMIC, name);
-                let jvrc1_sole = reference::jvrc1().sole_length_m;
-                key(
-                    name,
-                    round(base * d.sole_length_m / jvrc1_sole, 0.001),
-                    format!("{base} × sole length / {jvrc1_sole} m (JVRC-1's, measured)"),
-                )
-            }
+            "step_down_speed" => scaled(name, t, "m/s × t"),
+            "step_down_zmp_forward_m" => scaled(
+                name,
+                d.sole_length_m / jvrc1_sole,
+                &format!("× sole length / {jvrc1_sole} m"),
+            ),
             _ => kept(&reference::GAIT_DYNAMIC, name, "JVRC-1's"),
         });
     }

@@ -505,9 +505,10 @@ impl DynamicGaitConfig {
             .unwrap_or(STEP_DOUBLE_SUPPORT_FACTOR * self.double_support_s)
     }
 
-    /// The single support of a step down `drop` (m) deep that is not a stair descended past the
-    /// other foot: [`step_single_support`](Self::step_single_support), and no shorter than the
-    /// drop at `step_down_speed`.
+    /// The single support of a step up or down, not a stair taken past the other foot, landing
+    /// `drop` (m) below its lift-off (negative: above):
+    /// [`step_single_support`](Self::step_single_support), and down no shorter than the drop at
+    /// `step_down_speed`.
     pub fn step_down_single_support(&self, drop: f64) -> f64 {
         self.step_single_support().max(drop / self.step_down_speed)
     }
