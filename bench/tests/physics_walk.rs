@@ -266,8 +266,8 @@ mod walks {
     }
 
     /// JVRC-1's dynamic gait climbs the first 2 m of `stairs-up-15cm.toml` (seed 0: the floor,
-    /// then 0.15 m risers from 1 m along, both feet on each tread) to `done`, the soles ending at
-    /// least three stairs up. Its trailing heel rises about the toe before each swing up
+    /// then 0.15 m risers from 1 m along, one foot per tread since 2026-12-07, both feet on each
+    /// before) to `done`, the soles ending at least three stairs up. Its trailing heel rises about the toe before each swing up
     /// (`toe_off_rad` 0.5): with the sole kept flat the robot tipped at the first stair and fell
     /// after the fault in every walk (MuJoCo in process, seeds 0-3, and 1 of 10 over the
     /// processes), the upper knee at its 100 N·m limit through the single support.

@@ -358,24 +358,26 @@ fn check_stairs(name: &str, gait: Gait, s_max: Option<f64>, per_stair: usize, ri
     }
 }
 
-/// JVRC-1's dynamic stair limit (`stair_s_max` 0.65 m) takes two 0.10 m treads, 0.632 m in
-/// space: one foot per stair, up and down.
+/// JVRC-1's dynamic stair limit (`stair_s_max` 0.68 m) takes two 0.10 m treads (0.632 m in
+/// space) and two 0.15 m ones (0.671 m): one foot per stair, up and down.
 #[test]
 fn stairs_up_one_foot_per_tread() {
     check_stairs("stairs-up-10cm", Gait::Dynamic, None, 1, 1.0);
+    check_stairs("stairs-up-15cm", Gait::Dynamic, None, 1, 1.5);
 }
 
 #[test]
 fn stairs_down_one_foot_per_tread() {
     check_stairs("stairs-down-10cm", Gait::Dynamic, None, 1, -1.0);
+    check_stairs("stairs-down-15cm", Gait::Dynamic, None, 1, -1.5);
 }
 
-/// Two 0.15 m treads (0.672 m in space) are beyond JVRC-1's dynamic stair limit, and its static
+/// Two 0.185 m treads (0.705 m in space) are beyond JVRC-1's dynamic stair limit, and its static
 /// gait has none (its `s_max`, 0.24 m, is under one tread): both feet on every tread.
 #[test]
 fn a_step_limit_under_two_treads_puts_both_feet_on_every_tread() {
-    check_stairs("stairs-up-15cm", Gait::Dynamic, None, 2, 1.5);
-    check_stairs("stairs-down-15cm", Gait::Dynamic, None, 2, -1.5);
+    check_stairs("stairs-up-18cm", Gait::Dynamic, None, 2, 1.85);
+    check_stairs("stairs-down-18cm", Gait::Dynamic, None, 2, -1.85);
     check_stairs("stairs-up-10cm", Gait::Static, None, 2, 1.0);
     check_stairs("stairs-down-10cm", Gait::Static, None, 2, -1.0);
 }

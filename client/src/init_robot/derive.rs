@@ -7,8 +7,9 @@
 //! lengths scale with r, times and speeds with t):
 //!
 //! - dynamic gait timing: `single_support_s` = 0.55 s·t, `double_support_s` = 0.25 s·t (times k,
-//!   below); `max_step_up_m`, `max_step_down_m` = (0.15, 0.19) m·r; `step_down_speed` = 0.15
-//!   m/s·t; `step_down_zmp_forward_m` = 0.03 m × sole length / 0.20 m (JVRC-1's share of its
+//!   below); `max_step_up_m`, `max_step_down_m` = (0.15, 0.19) m·r; `step_down_speed`,
+//!   `climb_past_speed`, `descent_past_speed` = (0.15, 0.125, 0.115) m/s·t;
+//!   `step_down_zmp_forward_m` = 0.03 m × sole length / 0.20 m (JVRC-1's share of its
 //!   sole);
 //! - `[postprocess]` (static gait): `s_max` = min(0.24 m·r, 1.2 × sole length); `h_min`,
 //!   `h_max` = (0.03, 0.08) m·r; `scf` keeps JVRC-1's mapping of the human stride onto about
@@ -36,7 +37,7 @@
 //!   factor k, not below [`MIN_PERIOD_FRACTION`] of the Froude value) and the dynamic step with it
 //!   (the walking speed stays the Froude speed);
 //! - `[controller]`: JVRC-1's values but `max_step_m` = max(0.5 m·r, dynamic s_max + 0.02 m,
-//!   `stair_s_max` = 0.65 / 0.48 × dynamic s_max),
+//!   `stair_s_max` = 0.68 / 0.48 × dynamic s_max),
 //!   `lift_height_m`, `approach_height_m` ·r and `com_speed`, `swing_speed`, `lower_speed` ·t;
 //!   `torso_gain` at most the slowest torso joint's commanded speed limit over
 //!   [`TORSO_SATURATION_RAD`] (ARMAR-4's 0.4 rad/s torso pitch); roll-limited, ARMAR-4's bounds
@@ -410,7 +411,7 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
         stair_s_max,
         format!(
             "{} × s_max / {}: one foot per stair where two treads are a step this long (JVRC-1's \
-             ratio, measured on its 0.10 m stairs)",
+             ratio, measured on its 0.10 m and 0.15 m stairs)",
             reference::dynamic::STAIR_S_MAX,
             reference::dynamic::S_MAX
         ),
@@ -450,7 +451,9 @@ pub fn derive(d: &RobotDimensions) -> DerivedSections {
             "max_step_up_m" | "max_step_down_m" => {
                 scaled(name, r, "× l/l_ref: higher steps are refused")
             }
-            "step_down_speed" => scaled(name, t, "m/s × t"),
+            "step_down_speed" | "climb_past_speed" | "descent_past_speed" => {
+                scaled(name, t, "m/s × t")
+            }
             "step_down_zmp_forward_m" => scaled(
                 name,
                 d.sole_length_m / jvrc1_sole,
@@ -997,7 +1000,7 @@ mod tests {
         );
         assert_eq!(
             (s.o, s.zmp_inward_offset_m, s.max_step_m),
-            ((0.15, 0.24), 0.0, 0.65)
+            ((0.15, 0.24), 0.0, 0.68)
         );
         assert!(!s.roll.unwrap().limited);
     }

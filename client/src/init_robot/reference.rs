@@ -89,7 +89,7 @@ pub const CONTROLLER: [(&str, Tuned); 45] = [
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic]`, in its order.
-pub const GAIT_DYNAMIC: [(&str, Tuned); 21] = [
+pub const GAIT_DYNAMIC: [(&str, Tuned); 23] = [
     ("single_support_s", Tuned::Number(0.55)),
     ("double_support_s", Tuned::Number(0.25)),
     ("initial_double_support_s", Tuned::Number(1.0)),
@@ -107,6 +107,8 @@ pub const GAIT_DYNAMIC: [(&str, Tuned); 21] = [
     ("max_step_up_m", Tuned::Number(0.15)),
     ("max_step_down_m", Tuned::Number(0.19)),
     ("step_down_speed", Tuned::Number(0.15)),
+    ("climb_past_speed", Tuned::Number(0.125)),
+    ("descent_past_speed", Tuned::Number(0.115)),
     ("max_slope_rad", Tuned::Number(0.27)),
     ("toe_off_rad", Tuned::Number(0.5)),
     ("toe_off_s", Tuned::Number(0.25)),
@@ -164,7 +166,7 @@ pub mod dynamic {
     /// `rise_weight`.
     pub const RISE_WEIGHT: f64 = 3.5;
     /// `stair_s_max` (m).
-    pub const STAIR_S_MAX: f64 = 0.65;
+    pub const STAIR_S_MAX: f64 = 0.68;
 }
 
 /// ARMAR-4's hand-tuned values (`configs/armar4.toml`) that calibrate the rules for a robot

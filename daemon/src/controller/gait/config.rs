@@ -150,6 +150,18 @@ pub struct DynamicGaitConfig {
     /// standing knee lowers the body through the drop. JVRC-1 went down the 0.185 m stairs 1/4 at
     /// the 1.1 s of the 0.15 m ones, 10/10 at 1.2 and 1.3 s.
     pub step_down_speed: f64,
+    /// A stair climbed past the other foot lasts at least its riser (the landing's height above
+    /// the standing sole) over this speed in single support (m/s), and no less than
+    /// `climb_past_single_support_s`: the standing knee lifts the body through the riser.
+    /// JVRC-1 up the 0.15 m stairs one foot per stair (in process, seeds 0–29): 1.0 s 12/30,
+    /// 1.1 s 28/30, 1.2 s and 1.25 s 30/30, 1.3 s 28/30.
+    pub climb_past_speed: f64,
+    /// A stair descended past the other foot lasts at least its riser (the landing's depth below
+    /// the standing sole) over this speed in single support (m/s), and no less than
+    /// `descent_past_single_support_s`: the standing knee lowers the body through the riser.
+    /// JVRC-1 down the 0.15 m stairs one foot per stair (in process, seeds 0–29): 1.0 s 0/10,
+    /// 1.2 s 28/30, 1.25 s 29/30, 1.3 s 30/30.
+    pub descent_past_speed: f64,
     /// Steepest surface the dynamic gait stands on: a sole in contact tilted more than this
     /// from horizontal is refused (rad; docs/scenes.md, "Step heights"). JVRC-1 walks up and down
     /// the 15° ramp 10/10 under MuJoCo.
@@ -273,6 +285,8 @@ impl Default for DynamicGaitConfig {
             max_step_up_m: 0.15,
             max_step_down_m: 0.19,
             step_down_speed: 0.15,
+            climb_past_speed: 0.125,
+            descent_past_speed: 0.115,
             max_slope_rad: DYNAMIC_MAX_SLOPE_RAD,
             toe_off_rad: 0.5,
             toe_off_s: 0.25,
@@ -519,18 +533,22 @@ impl DynamicGaitConfig {
             .unwrap_or(CLIMB_SINGLE_SUPPORT_FACTOR * self.single_support_s)
     }
 
-    /// The single support of a stair climbed past the other foot (`climb_past_single_support_s`
-    /// or its default).
-    pub fn climb_past_single_support(&self) -> f64 {
+    /// The single support of a stair climbed past the other foot whose riser (its landing's
+    /// height above the standing sole) is `riser` (m): `climb_past_single_support_s` or its
+    /// default, and no shorter than the riser at `climb_past_speed`.
+    pub fn climb_past_single_support(&self, riser: f64) -> f64 {
         self.climb_past_single_support_s
             .unwrap_or(CLIMB_PAST_SINGLE_SUPPORT_FACTOR * self.single_support_s)
+            .max(riser / self.climb_past_speed)
     }
 
-    /// The single support of a stair descended past the other foot
-    /// (`descent_past_single_support_s` or its default).
-    pub fn descent_past_single_support(&self) -> f64 {
+    /// The single support of a stair descended past the other foot whose riser (its landing's
+    /// depth below the standing sole) is `riser` (m): `descent_past_single_support_s` or its
+    /// default, and no shorter than the riser at `descent_past_speed`.
+    pub fn descent_past_single_support(&self, riser: f64) -> f64 {
         self.descent_past_single_support_s
             .unwrap_or(DESCENT_PAST_SINGLE_SUPPORT_FACTOR * self.single_support_s)
+            .max(riser / self.descent_past_speed)
     }
 
     /// The double support next to a stair climbed (`climb_double_support_s` or its default).
@@ -686,6 +704,8 @@ impl DynamicGaitConfig {
             Bound::new("max_step_up_m", self.max_step_up_m, 0.0, 1.0),
             Bound::new("max_step_down_m", self.max_step_down_m, 0.0, 1.0),
             Bound::new("step_down_speed", self.step_down_speed, 0.01, 10.0),
+            Bound::new("climb_past_speed", self.climb_past_speed, 0.01, 10.0),
+            Bound::new("descent_past_speed", self.descent_past_speed, 0.01, 10.0),
             Bound::new("max_slope_rad", self.max_slope_rad, 0.0, 1.0),
             Bound::new("toe_off_rad", self.toe_off_rad, 0.0, 0.8),
             Bound::new("toe_off_s", self.toe_off_s, 0.01, 5.0),

@@ -12,9 +12,10 @@
 //! - a foot added (single → double support): the single-support phase in which it swings, from
 //!   lift-off through the highest post-processed swing pose of its flight to its contact pose;
 //!   it lasts `single_support_s` (a stair climbed: `climb_single_support_s`, past the other
-//!   foot, one foot per stair: `climb_past_single_support_s`; a stair descended past the other
-//!   foot: `descent_past_single_support_s`; any other step up or down: `step_single_support_s`,
-//!   down no shorter than its drop at `step_down_speed`);
+//!   foot, one foot per stair: `climb_past_single_support_s`, no shorter than its riser at
+//!   `climb_past_speed`; a stair descended past the other foot: `descent_past_single_support_s`,
+//!   no shorter than its riser at `descent_past_speed`; any other step up or down:
+//!   `step_single_support_s`, down no shorter than its drop at `step_down_speed`);
 //! - a foot added and the other released at once (single support on one foot, then on the
 //!   other): that swing, then a double support of `double_support_s` before the lift-off;
 //! - only hands change: a double support of `hand_transition_s` while they reach;
@@ -337,8 +338,9 @@ impl Builder<'_> {
     /// The single support of a swing from `lift_off` to `landing` while the other foot stands
     /// at `standing`: the stances its foot was in the air, if all timed, else
     /// `single_support_s`; a stair climbed no shorter than `climb_single_support()` (past the
-    /// standing foot, one foot per stair: `climb_past_single_support()`), a stair descended past
-    /// it no shorter than `descent_past_single_support()`, any other step up or down no shorter
+    /// standing foot, one foot per stair: `climb_past_single_support()` of its riser), a stair
+    /// descended past it no shorter than `descent_past_single_support()` of its riser, any other
+    /// step up or down no shorter
     /// than `step_single_support()` (down, than `step_down_single_support()` of its drop).
     fn swing_single_support(
         &mut self,
@@ -348,11 +350,14 @@ impl Builder<'_> {
     ) -> (f64, PhaseTiming) {
         let limits = self.timing.timed_single_support();
         let dwell = std::mem::replace(&mut self.dwell, Dwell::Empty);
+        // A stair taken past the standing foot: its riser is the landing's height above that
+        // sole (a past stair has one: `standing` is set).
+        let riser = standing.map_or(0.0, |s| (landing.translation.z - s.translation.z).abs());
         let step = match Rise::of(lift_off, landing, standing) {
             Rise::Level => return timed(dwell, self.timing.single_support_s, limits, 0.0),
-            Rise::ClimbPast => self.timing.climb_past_single_support(),
+            Rise::ClimbPast => self.timing.climb_past_single_support(riser),
             Rise::Stair => self.timing.climb_single_support(),
-            Rise::DescentPast => self.timing.descent_past_single_support(),
+            Rise::DescentPast => self.timing.descent_past_single_support(riser),
             Rise::Step => {
                 let drop = lift_off.translation.z - landing.translation.z;
                 self.timing.step_down_single_support(drop)
@@ -593,12 +598,14 @@ mod tests {
     fn a_stair_climbed_past_the_other_foot_takes_the_past_supports() {
         let timing = DynamicGaitConfig::default();
         let plan = FootstepPlan::new(&one_foot_per_stair(0.1), standing(), &timing).unwrap();
-        let past = timing.climb_past_single_support();
+        let past = timing.climb_past_single_support(0.1);
         assert_eq!(
             durations(&plan, true),
             [timing.climb_single_support(), past, past]
         );
         assert!(past > timing.climb_single_support());
+        // A 0.10 m riser at `climb_past_speed` would be quicker: the configured duration holds.
+        assert_eq!(past, timing.climb_past_single_support(0.0));
         // The double support before the first stair climbed past the other foot is a past one
         // too: its feet stand one riser apart, as between any two.
         assert_eq!(
@@ -614,15 +621,46 @@ mod tests {
         let plan = FootstepPlan::new(&one_foot_per_stair(-0.1), standing(), &timing).unwrap();
         let (step, past) = (
             timing.step_single_support(),
-            timing.descent_past_single_support(),
+            timing.descent_past_single_support(0.1),
         );
         assert_eq!(durations(&plan, true), [step, past, past]);
         assert!(past < step);
+        assert_eq!(past, timing.descent_past_single_support(0.0));
         assert_eq!(
             durations(&plan, false),
             past_doubles(&timing, timing.step_double_support())
         );
         assert!(timing.past_double_support() < timing.step_double_support());
+    }
+
+    #[test]
+    fn a_high_stair_taken_past_the_other_foot_lasts_its_riser_at_the_past_speed() {
+        let timing = DynamicGaitConfig::default();
+        let riser = 0.15;
+        let up = FootstepPlan::new(&one_foot_per_stair(riser), standing(), &timing).unwrap();
+        let climb = riser / timing.climb_past_speed;
+        assert!(climb > timing.climb_past_single_support(0.0));
+        assert_close(
+            &durations(&up, true),
+            &[timing.climb_single_support(), climb, climb],
+        );
+        let down = FootstepPlan::new(&one_foot_per_stair(-riser), standing(), &timing).unwrap();
+        let descent = riser / timing.descent_past_speed;
+        assert!(descent > timing.descent_past_single_support(0.0));
+        assert_close(
+            &durations(&down, true),
+            &[timing.step_down_single_support(riser), descent, descent],
+        );
+    }
+
+    /// `actual` and `expected` agree to rounding (the risers are differences of heights).
+    fn assert_close(actual: &[f64], expected: &[f64]) {
+        assert_eq!(actual.len(), expected.len(), "{actual:?} {expected:?}");
+        let close = actual
+            .iter()
+            .zip(expected)
+            .all(|(a, e)| (a - e).abs() < 1e-9);
+        assert!(close, "{actual:?} {expected:?}");
     }
 
     #[test]

@@ -10,8 +10,11 @@
 //! A step up or down (landing and lift-off more than [`STEP_HEIGHT_M`] apart, a stair or a ramp)
 //! moves horizontally over part of the swing only, so the sole is high before it passes an edge:
 //! climbing, the foot first rises for [`EDGE_CLEARING_SHARE`] of the swing, so its toe clears
-//! the riser in front of it; descending, it arrives above its landing that share before the
-//! end, so its heel clears the nosing behind the landing while it comes down.
+//! the riser in front of it, and it arrives above its landing [`SET_DOWN_SHARE`] before the end,
+//! holding the apex's height until then and coming straight down onto the tread, so its heel
+//! clears the nosing it lands behind and it touches down at rest, not sliding onto the tread;
+//! descending, it arrives above its landing [`EDGE_CLEARING_SHARE`] before the end, so its heel
+//! clears the nosing behind the landing while it comes down.
 
 use nalgebra::{Isometry3, Translation3, Vector2};
 
@@ -21,15 +24,24 @@ use crate::controller::trajectory::{PointTrajectory, PoseTrajectory, Profile};
 /// The share of a step up's (down's) swing before (after) its horizontal motion.
 pub(crate) const EDGE_CLEARING_SHARE: f64 = 0.25;
 
+/// The share of a step up's swing in which the foot comes straight down onto its landing (the
+/// 15 cm stairs climbed one foot per stair tipped 10 of 10 walks with the foot sliding onto the
+/// tread, docs/controller.md, "Swing").
+pub(crate) const SET_DOWN_SHARE: f64 = 0.2;
+
 /// A swing from lift-off to landing.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SwingTrajectory {
     horizontal: PointTrajectory,
     /// When the horizontal motion starts, after lift-off (s).
     horizontal_start: f64,
+    /// Up to the apex, from lift-off.
     rise: PoseTrajectory,
+    /// Down from the apex, from `descent_start`.
     descent: PoseTrajectory,
-    duration: f64,
+    /// When the descent from the apex starts, after lift-off (s); between the rise's end and
+    /// then the foot keeps the apex's height and orientation.
+    descent_start: f64,
 }
 
 impl SwingTrajectory {
@@ -51,19 +63,20 @@ impl SwingTrajectory {
         let half = duration / 2.0;
         let climb = landing.translation.z - lift_off.translation.z;
         let edge_clearing = EDGE_CLEARING_SHARE * duration;
-        let (horizontal_start, horizontal_duration) = if climb > STEP_HEIGHT_M {
-            (edge_clearing, duration - edge_clearing)
+        let (horizontal_start, horizontal_end, descent_duration) = if climb > STEP_HEIGHT_M {
+            let set_down = SET_DOWN_SHARE * duration;
+            (edge_clearing, duration - set_down, set_down)
         } else if climb < -STEP_HEIGHT_M {
-            (0.0, duration - edge_clearing)
+            (0.0, duration - edge_clearing, half)
         } else {
-            (0.0, duration)
+            (0.0, duration, half)
         };
         Self {
-            horizontal: PointTrajectory::new(start, goal, horizontal_duration),
+            horizontal: PointTrajectory::new(start, goal, horizontal_end - horizontal_start),
             horizontal_start,
             rise: PoseTrajectory::new(lift_off, top, half, Profile::MinimumJerk),
-            descent: PoseTrajectory::new(top, landing, half, Profile::MinimumJerk),
-            duration,
+            descent: PoseTrajectory::new(top, landing, descent_duration, Profile::MinimumJerk),
+            descent_start: duration - descent_duration,
         }
     }
 
@@ -75,13 +88,13 @@ impl SwingTrajectory {
     /// Pose and world velocity (linear xyz, angular xyz) at time `t` after lift-off; after the
     /// swing, the landing pose at rest.
     pub fn sample(&self, t: f64) -> (Isometry3<f64>, [f64; 6]) {
-        let half = self.duration / 2.0;
         let (xy, xy_velocity): (Vector2<f64>, Vector2<f64>) =
             self.horizontal.sample(t - self.horizontal_start);
-        let (mut pose, mut velocity) = if t < half {
+        let (mut pose, mut velocity) = if t < self.descent_start {
+            // After the rise the pose stays at the apex, at rest.
             self.rise.sample(t)
         } else {
-            self.descent.sample(t - half)
+            self.descent.sample(t - self.descent_start)
         };
         pose.translation.x = xy.x;
         pose.translation.y = xy.y;
@@ -187,6 +200,28 @@ mod tests {
         let shaped = SwingTrajectory::new(at(0.0, 0.0), at(0.3, 0.23), at(0.6, 0.2), 1.0);
         let (delayed, _) = shaped.sample(0.2);
         assert!(delayed.translation.x < early.translation.x - 0.03);
+    }
+
+    #[test]
+    fn a_step_up_arrives_above_its_landing_then_comes_straight_down() {
+        let at = |x: f64, z: f64| Isometry3::translation(x, 0.1, z);
+        let swing = SwingTrajectory::new(at(0.0, 0.0), at(0.3, 0.23), at(0.6, 0.2), 1.0);
+        let (above, velocity) = swing.sample(1.0 - SET_DOWN_SHARE);
+        assert!((above.translation.vector - at(0.6, 0.23).translation.vector).norm() < 1e-12);
+        assert!(velocity.iter().all(|v| v.abs() < 1e-12), "{velocity:?}");
+        for k in 0..20 {
+            let (pose, velocity) = swing.sample(1.0 - SET_DOWN_SHARE + f64::from(k) * 0.01);
+            assert!((pose.translation.x - 0.6).abs() < 1e-12);
+            assert!(
+                velocity[0].abs() < 1e-12 && velocity[2] <= 0.0,
+                "{velocity:?}"
+            );
+        }
+        // A step down still moves horizontally until a quarter before the end, coming down
+        // from mid-swing.
+        let down = SwingTrajectory::new(at(0.0, 0.0), at(0.3, 0.03), at(0.6, -0.2), 1.0);
+        let (pose, _) = down.sample(1.0 - SET_DOWN_SHARE);
+        assert!((pose.translation.x - 0.6).abs() < 1e-12 && pose.translation.z < 0.0);
     }
 
     #[test]
