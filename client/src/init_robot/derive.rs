@@ -232,7 +232,6 @@ fn kept(table: &[(&'static str, Tuned)], name: &'static str, rule: &str) -> Line
     let value = match reference::tuned(table, name) {
         Tuned::Number(x) if x != 0.0 && x.abs() < 1e-3 => Value::Exponent(x),
         Tuned::Number(x) => Value::Number(x),
-        Tuned::Integer(i) => Value::Integer(i),
         Tuned::Switch(b) => Value::Switch(b),
     };
     Line::Key {
@@ -805,7 +804,7 @@ fn controller_heading(key: &str) -> Option<&'static str> {
         }
         "com_tolerance_m" => "tolerances: contacts (feet), swing apex (via), hand contacts",
         "release_force_fraction" => {
-            "FT contact detection: fractions of the robot's weight, touchdown debounced over N ticks"
+            "FT contact detection: fractions of the robot's weight, and how long a touchdown must hold [s]"
         }
         "phase_timeout_s" => {
             "a phase may overrun its planned duration by this much before it is a fault"

@@ -33,8 +33,6 @@ pub fn jvrc1() -> RobotDimensions {
 pub enum Tuned {
     /// A number.
     Number(f64),
-    /// A whole number.
-    Integer(i64),
     /// A switch.
     Switch(bool),
 }
@@ -75,7 +73,7 @@ pub const CONTROLLER: [(&str, Tuned); 45] = [
     ("hand_orientation_tolerance_rad", Tuned::Number(0.1)),
     ("release_force_fraction", Tuned::Number(0.1)),
     ("touchdown_force_fraction", Tuned::Number(0.1)),
-    ("touchdown_debounce_ticks", Tuned::Integer(3)),
+    ("touchdown_debounce_s", Tuned::Number(0.006)),
     ("phase_timeout_s", Tuned::Number(5.0)),
     ("max_step_m", Tuned::Number(0.65)),
     ("max_step_up_m", Tuned::Number(0.06)),
@@ -210,7 +208,6 @@ pub fn tuned(table: &[(&str, Tuned)], key: &str) -> Tuned {
 pub fn number(table: &[(&str, Tuned)], key: &str) -> f64 {
     match tuned(table, key) {
         Tuned::Number(x) => x,
-        Tuned::Integer(i) => i as f64,
         Tuned::Switch(_) => panic!("{key} is a switch"),
     }
 }

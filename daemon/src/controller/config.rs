@@ -100,8 +100,10 @@ pub struct ControllerConfig {
     pub release_force_fraction: f64,
     /// A touchdown is confirmed when the FT normal force exceeds this fraction of the weight ...
     pub touchdown_force_fraction: f64,
-    /// ... for this many consecutive ticks.
-    pub touchdown_debounce_ticks: u32,
+    /// ... for this long without a break (s); a time, not a count of ticks, so a touchdown is
+    /// confirmed as fast at 1 kHz as at 500 Hz. It was 3 ticks, 6 ms at 500 Hz; JVRC-1 up the
+    /// 0.15 m stairs at 1 kHz, in process, seeds 0–29: 21/30 at 3 ms, 26/30 at 6 ms.
+    pub touchdown_debounce_s: f64,
     /// While a walk executes, the feet together must carry at least this fraction of the
     /// weight, but for moments of up to `unloaded_max_s`; longer is a measurement fault (a
     /// force-torque dropout: a walking robot always stands on a foot).
@@ -259,7 +261,7 @@ impl Default for ControllerConfig {
             touchdown_force_fraction: 0.1,
             support_force_min_fraction: 0.1,
             unloaded_max_s: 0.05,
-            touchdown_debounce_ticks: 3,
+            touchdown_debounce_s: 0.006,
             phase_timeout_s: 5.0,
             max_step_m: 0.5,
             max_step_up_m: 0.06,
@@ -371,7 +373,6 @@ impl ControllerConfig {
 
     /// The section's table: every numeric key, its value and its range, one line a key.
     pub fn bounds(&self) -> Vec<Bound> {
-        let ticks = f64::from(self.touchdown_debounce_ticks);
         let mut bounds = vec![
             Bound::new("com_weight", self.com_weight, 1e-6, 1e6),
             Bound::new("foot_weight", self.foot_weight, 1e-6, 1e6),
@@ -460,7 +461,7 @@ impl ControllerConfig {
                 1e-3,
                 1.0,
             ),
-            Bound::new("touchdown_debounce_ticks", ticks, 1.0, 1000.0),
+            Bound::new("touchdown_debounce_s", self.touchdown_debounce_s, 0.0, 1.0),
             Bound::new(
                 "support_force_min_fraction",
                 self.support_force_min_fraction,

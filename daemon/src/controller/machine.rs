@@ -12,6 +12,7 @@ use kinematics::robot::{EndEffector, SoleRectangle};
 use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
 
 use super::config::ControllerConfig;
+use super::debounce::Debounce;
 use super::gait::{distribute, force_difference_velocities};
 use super::hand_press::reach_goal;
 use super::hand_support::{HandLoad, HandSupport, hand_slot};
@@ -228,7 +229,7 @@ pub(crate) struct StateMachine {
     step: usize,
     phase_time: f64,
     deadline: f64,
-    debounce: u32,
+    debounce: Debounce,
     motion: PoseTrajectory,
     /// Whether the current motion ends at a via pose (a swing apex) rather than an approach.
     motion_is_via: bool,
@@ -277,7 +278,7 @@ impl StateMachine {
             step: 0,
             phase_time: 0.0,
             deadline: f64::INFINITY,
-            debounce: 0,
+            debounce: Debounce::default(),
             motion: PoseTrajectory::hold(Isometry3::identity()),
             motion_is_via: false,
             com_motion: PointTrajectory::new(Vector2::zeros(), Vector2::zeros(), 1.0),
@@ -421,7 +422,7 @@ impl StateMachine {
         self.plan = TransitionPlan::catch(foot);
         self.step = 0;
         self.phase_time = 0.0;
-        self.debounce = 0;
+        self.debounce.reset();
         self.deadline = CATCH_S + self.config.phase_timeout_s;
         self.put_down = Some((foot, below));
         true
@@ -472,7 +473,7 @@ impl StateMachine {
         self.plan = TransitionPlan::step_back(foot);
         self.step = 0;
         self.phase_time = 0.0;
-        self.debounce = 0;
+        self.debounce.reset();
         self.deadline = self.motion.duration() + self.config.phase_timeout_s;
         self.put_down = Some((foot, back));
     }
@@ -503,7 +504,7 @@ impl StateMachine {
             progress = Progress::Stopping(FaultCode::StepOutOfReach);
         }
         loop {
-            match self.check_step(feedback) {
+            match self.check_step(feedback, dt) {
                 StepStatus::Running => break,
                 StepStatus::TimedOut if self.current_step().phase == Phase::Reach => {
                     self.give_up_reach(&feedback.pelvis);
@@ -659,7 +660,7 @@ impl StateMachine {
 
     fn enter_step(&mut self, feedback: &Feedback) {
         self.phase_time = 0.0;
-        self.debounce = 0;
+        self.debounce.reset();
         self.motion_is_via = false;
         let step = self.current_step();
         let c = self.config;
@@ -837,12 +838,13 @@ impl StateMachine {
         self.com_support.set_soles(staying, &self.sole, |p| p);
     }
 
-    fn check_step(&mut self, feedback: &Feedback) -> StepStatus {
+    fn check_step(&mut self, feedback: &Feedback, dt: f64) -> StepStatus {
         let step = self.current_step();
         let caught_on_ground = match (self.put_down, step.phase) {
-            (Some((foot, _)), Phase::Swing) => {
-                self.debounced(feedback.normal_forces[foot as usize] > self.touchdown_force)
-            }
+            (Some((foot, _)), Phase::Swing) => self.debounced(
+                feedback.normal_forces[foot as usize] > self.touchdown_force,
+                dt,
+            ),
             _ => false,
         };
         let c = &self.config;
@@ -858,11 +860,12 @@ impl StateMachine {
             (Phase::Unload, Some(e)) => {
                 let asked_no_more = e.is_foot() || self.hand_support.unloaded(e, &self.config);
                 let released = feedback.normal_forces[e as usize] < self.release_force;
-                asked_no_more && self.debounced(released)
+                asked_no_more && self.debounced(released, dt)
             }
-            (Phase::Lower, Some(foot)) => {
-                self.debounced(feedback.normal_forces[foot as usize] > self.touchdown_force)
-            }
+            (Phase::Lower, Some(foot)) => self.debounced(
+                feedback.normal_forces[foot as usize] > self.touchdown_force,
+                dt,
+            ),
             // A caught foot's fast descent ends where it meets the ground, if that comes first.
             (Phase::Swing, Some(_)) if caught_on_ground => true,
             (Phase::Lift | Phase::Swing | Phase::Reach, Some(e)) => {
@@ -894,10 +897,10 @@ impl StateMachine {
         }
     }
 
-    /// Counts consecutive ticks with `condition`; true once the debounce count is reached.
-    fn debounced(&mut self, condition: bool) -> bool {
-        self.debounce = if condition { self.debounce + 1 } else { 0 };
-        self.debounce >= self.config.touchdown_debounce_ticks
+    /// Whether `condition` has held, through this tick of `dt` (s), for `touchdown_debounce_s`.
+    fn debounced(&mut self, condition: bool, dt: f64) -> bool {
+        let hold_s = self.config.touchdown_debounce_s;
+        self.debounce.update(condition, dt, hold_s)
     }
 
     fn finish_step(&mut self, feedback: &Feedback) {

@@ -38,6 +38,7 @@
 
 mod assembly;
 mod config;
+mod debounce;
 mod estimator;
 mod gait;
 mod hand_clearance;

@@ -52,6 +52,7 @@ use super::stabilizer::{Measured, Stabilizer};
 use super::swing::SwingTrajectory;
 use super::toe_off::{ToeOff, reachable_pitch};
 use crate::controller::config::ControllerConfig;
+use crate::controller::debounce::Debounce;
 use crate::controller::hand_press::reach_goal;
 use crate::controller::machine::{
     Balance, ComHeight, Feedback, PoseTarget, Progress, STEP_HEIGHT_M, Targets, heading_frame,
@@ -113,7 +114,7 @@ pub(crate) struct DynamicWalker {
     /// Time waited past a planned touchdown (s).
     late_s: Option<f64>,
     settle_s: f64,
-    debounce: u32,
+    touchdown: Debounce,
     cursor: usize,
     swing: Option<Swing>,
     /// A controlled stop, once one began.
@@ -160,7 +161,7 @@ impl DynamicWalker {
             transition: 0,
             late_s: None,
             settle_s: 0.0,
-            debounce: 0,
+            touchdown: Debounce::default(),
             cursor: 0,
             swing: None,
             stop: None,
@@ -340,7 +341,7 @@ impl DynamicWalker {
             self.clock += dt;
         }
         self.blind = !(sensors.measured && self.trusts_force_sensors());
-        let mut progress = self.advance(feedback);
+        let mut progress = self.advance(feedback, dt);
         if progress == Progress::Fault(FaultCode::MissedTouchdown) && self.stop.is_none() {
             // The foot may stand on the ground with a sensor that does not say so: stop, and
             // land it by position.
@@ -409,7 +410,7 @@ impl DynamicWalker {
         self.transition = 0;
         self.late_s = None;
         self.settle_s = 0.0;
-        self.debounce = 0;
+        self.touchdown.reset();
         self.cursor = 0;
         self.swing = None;
         self.reaches = [None; 2];
@@ -417,7 +418,7 @@ impl DynamicWalker {
     }
 
     /// Moves through the phases the plan clock has passed.
-    fn advance(&mut self, feedback: &Feedback) -> Progress {
+    fn advance(&mut self, feedback: &Feedback, dt: f64) -> Progress {
         loop {
             let Some(phase) = self.current_phase() else {
                 return self.settle(feedback);
@@ -425,7 +426,8 @@ impl DynamicWalker {
             match phase.support {
                 Support::Single(swing) => {
                     let i = swing.foot as usize;
-                    if !self.targets.contacts[i] && self.touchdown(feedback, &phase, &swing) {
+                    if !self.targets.contacts[i] && self.touched_down(feedback, &phase, &swing, dt)
+                    {
                         self.land(swing.foot, feedback);
                     }
                     if self.clock < phase.end_s() {
@@ -471,11 +473,17 @@ impl DynamicWalker {
 
     /// The swing foot has touched down: confirmed by force-torque, or by position on a tick
     /// that is blind to force-torque.
-    fn touchdown(&mut self, feedback: &Feedback, phase: &SupportPhase, swing: &SwingPlan) -> bool {
+    fn touched_down(
+        &mut self,
+        feedback: &Feedback,
+        phase: &SupportPhase,
+        swing: &SwingPlan,
+        dt: f64,
+    ) -> bool {
         if self.blind {
             self.clock >= phase.end_s() && self.at_foothold(feedback, swing)
         } else {
-            self.touchdown_confirmed(feedback, phase, swing.foot as usize)
+            self.touchdown_confirmed(feedback, phase, swing.foot as usize, dt)
         }
     }
 
@@ -492,11 +500,14 @@ impl DynamicWalker {
         feedback: &Feedback,
         phase: &SupportPhase,
         foot: usize,
+        dt: f64,
     ) -> bool {
         let pressed = feedback.normal_forces[foot] > self.touchdown_force;
-        self.debounce = if pressed { self.debounce + 1 } else { 0 };
+        let held = self
+            .touchdown
+            .update(pressed, dt, self.config.touchdown_debounce_s);
         let due = self.clock >= phase.end_s() - self.plan().config.early_touchdown_s;
-        due && self.debounce >= self.config.touchdown_debounce_ticks
+        due && held
     }
 
     /// Anchors a foot where it landed: at its contact surface's height when force-torque
@@ -544,7 +555,7 @@ impl DynamicWalker {
 
     fn next_phase(&mut self, feedback: &Feedback) {
         self.phase += 1;
-        self.debounce = 0;
+        self.touchdown.reset();
         self.late_s = None;
         let ends_transition = self
             .plan()
