@@ -340,8 +340,8 @@ impl Builder<'_> {
     /// `single_support_s`; a stair climbed no shorter than `climb_single_support()` (past the
     /// standing foot, one foot per stair: `climb_past_single_support()` of its riser), a stair
     /// descended past it no shorter than `descent_past_single_support()` of its riser, any other
-    /// step up or down no shorter
-    /// than `step_single_support()` (down, than `step_down_single_support()` of its drop).
+    /// step up or down no shorter than `step_single_support()` (down, than
+    /// `step_down_single_support()` of its drop).
     fn swing_single_support(
         &mut self,
         lift_off: &Isometry3<f64>,
