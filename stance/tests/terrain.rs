@@ -122,8 +122,19 @@ fn depth(surface: &SupportSurface, y: f64) -> f64 {
     to - from
 }
 
+/// The room a sole keeps ahead of its toe: none where the surface ends at a drop (what lies
+/// just past the margin is 0.02 m or more lower, a stair going down), else `TOE_MARGIN_M`.
+fn toe_margin(environment: &Environment, pose: &Isometry3<f64>, length: f64) -> f64 {
+    let ahead = pose * Point3::new(length / 2.0 + TOE_MARGIN_M, 0.0, 0.0);
+    let lower_ahead = environment
+        .highest_at(ahead.x, ahead.y)
+        .is_some_and(|z| z <= pose.translation.z - 0.02);
+    if lower_ahead { 0.0 } else { TOE_MARGIN_M }
+}
+
 /// Every contact sole: on its surface's plane, parallel to it, with the sole's heel and toe on
-/// the same surface with the margins (corners of the sole, lengthened by the margins).
+/// the same surface with the margins (corners of the sole, lengthened by the margins; no toe
+/// margin before a drop).
 fn check_soles_fit(poses: &PoseSequence, environment: &Environment, sole: [f64; 2]) {
     let [length, width] = sole;
     for i in 0..poses.len() {
@@ -146,7 +157,7 @@ fn check_soles_fit(poses: &PoseSequence, environment: &Environment, sole: [f64; 
                 surface.name
             );
             let heel = -length / 2.0 - HEEL_MARGIN_M + EPS;
-            let toe = length / 2.0 + TOE_MARGIN_M - EPS;
+            let toe = length / 2.0 + toe_margin(environment, pose, length) - EPS;
             for (x, y) in [
                 (heel, width / 2.0),
                 (heel, -width / 2.0),

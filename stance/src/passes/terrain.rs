@@ -26,8 +26,16 @@ use crate::poses::{FEET, HANDS, PoseSequence};
 pub const HEEL_MARGIN_M: f64 = 0.05;
 
 /// Room (m) left between a foothold's toe and the front edge of its surface: more than at the
-/// heel, because there the toe meets the next riser of a stair going up.
+/// heel, because there the toe meets the next riser of a stair going up. Not at a drop
+/// ([`DROP_M`]): there is no riser ahead to meet, and the step down from the edge is the shorter
+/// for it. ARMAR-4's static gait, whose standing leg reaches no lower with its ankle at its
+/// bound, stopped 38 mm above the first tread down after a 0.33 m step (MuJoCo,
+/// `stairs-down-10cm`, 2 of 10 walks).
 pub const TOE_MARGIN_M: f64 = 0.03;
+
+/// A surface whose next one along the path begins at least this much (m) lower ends at a drop,
+/// the nosing of a stair going down; a ramp's kink or a floor's seam does not.
+const DROP_M: f64 = 0.02;
 
 /// A foot this close (m) to the end of its surface's fit interval has come up to the edge.
 const EDGE_REACHED_M: f64 = 0.01;
@@ -269,15 +277,39 @@ impl Footholds<'_> {
         let (Some(from), Some(at)) = (self.along[f], self.surface[f]) else {
             return f64::INFINITY;
         };
-        let elevation = |k: usize, along: f64| {
-            let point = self.path.point(along, lateral);
-            self.environment.surfaces[k].plane_elevation_at(point.x, point.y)
-        };
         let reach = |rise: f64| (limit.powi(2) - (weight * rise).powi(2)).max(0.0).sqrt();
         let flat = from + limit;
-        match (elevation(at, from), elevation(k, flat)) {
+        match (
+            self.elevation(at, from, lateral),
+            self.elevation(k, flat, lateral),
+        ) {
             (Some(start), Some(end)) => from + reach(end - start),
             _ => flat,
+        }
+    }
+
+    /// The elevation of surface `k`'s plane at `along` on the line `lateral`.
+    fn elevation(&self, k: usize, along: f64, lateral: f64) -> Option<f64> {
+        let point = self.path.point(along, lateral);
+        self.environment.surfaces[k].plane_elevation_at(point.x, point.y)
+    }
+
+    /// Whether surface `k` ends at a drop along the line `lateral` ([`DROP_M`]): the surface
+    /// after it begins that much lower than `k` ends.
+    fn ends_at_a_drop(&self, k: usize, lateral: f64) -> bool {
+        let Some(extent) = self.extent(k, lateral) else {
+            return false;
+        };
+        let Some(next) = self.next(&extent, lateral) else {
+            return false;
+        };
+        let (end, start) = (
+            self.elevation(k, extent.to, lateral),
+            self.elevation(next.surface, next.from, lateral),
+        );
+        match (end, start) {
+            (Some(end), Some(start)) => end - start >= DROP_M,
+            _ => false,
         }
     }
 
@@ -288,9 +320,14 @@ impl Footholds<'_> {
     /// the foot's landing.
     fn fit(&self, k: usize, along: f64, sole: &Isometry3<f64>) -> f64 {
         let lateral = self.path.lateral(&sole.translation.vector);
+        let toe_margin = if self.ends_at_a_drop(k, lateral) {
+            0.0
+        } else {
+            TOE_MARGIN_M
+        };
         let (back, front) = (
             -self.sole.length / 2.0 - HEEL_MARGIN_M,
-            self.sole.length / 2.0 + TOE_MARGIN_M,
+            self.sole.length / 2.0 + toe_margin,
         );
         let side = self.sole.width / 2.0;
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
@@ -675,7 +712,8 @@ mod tests {
         assert_footholds(&p, &[&SHORT_STEPS[..], &on].concat());
     }
 
-    /// A 0.15 m drop at x = 0.5 onto a floor whose fit interval starts at 0.65.
+    /// A 0.15 m drop at x = 0.5 from a landing whose fit interval ends at 0.4 onto a floor whose
+    /// fit interval starts at 0.65.
     fn drop() -> Environment {
         Environment {
             surfaces: vec![
@@ -696,6 +734,17 @@ mod tests {
         let [x, z] = found[found.len() - 1];
         let along = (0.48f64.powi(2) - 0.15f64.powi(2)).sqrt();
         assert!((x - (0.2 + along)).abs() < 1e-12 && z == 0.0, "{found:?}");
+    }
+
+    #[test]
+    fn a_foot_comes_up_to_a_drop_with_its_toe_at_the_edge() {
+        // The left foot's landing at 0.45 is clamped to the landing's fit interval: it ends at
+        // the edge less half the sole (0.4), no toe margin, since no riser lies ahead. Before a
+        // step up the same edge keeps the margin (`TO_THE_FLOOR_EDGE`: 0.37).
+        let mut p = flat_walk(&[0.2, 0.45]);
+        place(&mut p, &drop(), 0.48, 1.0);
+        let found = footholds(&p);
+        assert_eq!(found[found.len() - 1], [0.4, 0.15], "{found:?}");
     }
 
     #[test]
