@@ -58,7 +58,10 @@ fn controller_tick_does_not_allocate() {
             radius: 0.02,
             available: [0.0, 1.0],
         });
-        let sequence = walk_support::synthetic_walk_in(&h.robot, 2, 0.08, true, environment);
+        // The left hand is held where the static gait holds railings (JVRC-1's; ARMAR-4's
+        // refuses a held hand in a scene with railings: docs/scenes.md, "Hands on railings").
+        let held = walk_support::controller_config(robot).hold_railings;
+        let sequence = walk_support::synthetic_walk_in(&h.robot, 2, 0.08, held, environment);
         h.start(&sequence);
         let end = walk_counting_allocations(robot, h, |_, _| {});
         assert_eq!(end, ControllerState::Done, "{robot}");

@@ -822,6 +822,10 @@ fn controller_heading(key: &str) -> Option<&'static str> {
              gait (docs/scenes.md, \"Step heights\")"
         }
         "max_slope_rad" => "... or with a sole standing on a slope steeper than this (rad)",
+        "hold_railings" => {
+            "... or with a hand holding a railing, unless this is on (docs/scenes.md, \"Hands on \
+             railings\")"
+        }
         "standing_crouch_max_m" => {
             "with a foot in the air (static gait), take the step back when landing it would need \
              the standing leg to lower the body deeper than this (m)"

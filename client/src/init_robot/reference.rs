@@ -38,7 +38,7 @@ pub enum Tuned {
 }
 
 /// `configs/jvrc1.toml` `[controller]`, in its order.
-pub const CONTROLLER: [(&str, Tuned); 45] = [
+pub const CONTROLLER: [(&str, Tuned); 46] = [
     ("com_weight", Tuned::Number(10.0)),
     ("foot_weight", Tuned::Number(10.0)),
     ("unload_foot_weight", Tuned::Number(10.0)),
@@ -79,6 +79,7 @@ pub const CONTROLLER: [(&str, Tuned); 45] = [
     ("max_step_up_m", Tuned::Number(0.06)),
     ("max_step_down_m", Tuned::Number(0.06)),
     ("max_slope_rad", Tuned::Number(0.18)),
+    ("hold_railings", Tuned::Switch(true)),
     ("command_lead_max_rad", Tuned::Number(0.05)),
     ("tipping_detection_rad", Tuned::Number(0.25)),
     ("catch_tilt_rad", Tuned::Number(0.1)),
@@ -87,7 +88,7 @@ pub const CONTROLLER: [(&str, Tuned); 45] = [
 ];
 
 /// `configs/jvrc1.toml` `[gait.dynamic]`, in its order.
-pub const GAIT_DYNAMIC: [(&str, Tuned); 23] = [
+pub const GAIT_DYNAMIC: [(&str, Tuned); 24] = [
     ("single_support_s", Tuned::Number(0.55)),
     ("double_support_s", Tuned::Number(0.25)),
     ("initial_double_support_s", Tuned::Number(1.0)),
@@ -108,6 +109,7 @@ pub const GAIT_DYNAMIC: [(&str, Tuned); 23] = [
     ("climb_past_speed", Tuned::Number(0.125)),
     ("descent_past_speed", Tuned::Number(0.115)),
     ("max_slope_rad", Tuned::Number(0.27)),
+    ("hold_railings", Tuned::Switch(false)),
     ("toe_off_rad", Tuned::Number(0.5)),
     ("toe_off_s", Tuned::Number(0.25)),
     ("step_down_zmp_forward_m", Tuned::Number(0.03)),

@@ -9,7 +9,7 @@ use kinematics::{ConfigFile, ConfigFileError};
 use serde::Deserialize;
 
 use super::gait::force_difference_bounds;
-use super::sequence::TerrainLimits;
+use super::sequence::SceneLimits;
 
 /// The section [`ControllerConfig`] is read from.
 const SECTION: &str = "controller";
@@ -126,6 +126,10 @@ pub struct ControllerConfig {
     /// Steepest surface the static gait stands on: a sole in contact tilted more than this from
     /// horizontal is refused (rad; docs/scenes.md, "Step heights").
     pub max_slope_rad: f64,
+    /// Whether the static gait walks with a hand holding a railing: off, a sequence whose scene
+    /// has railings and whose stances hold a hand is refused (docs/scenes.md, "Hands on
+    /// railings"). JVRC-1 walks `railing.toml` holding it 40/40 (MuJoCo); ARMAR-4 fell.
+    pub hold_railings: bool,
     /// How far the integrated joint command may lead the measured angle (rad). The command is
     /// integrated from the previous command, so a loaded joint keeps the servo offset that holds
     /// its load; this bound stops the integral from winding up when a joint is blocked.
@@ -267,6 +271,7 @@ impl Default for ControllerConfig {
             max_step_up_m: 0.06,
             max_step_down_m: 0.06,
             max_slope_rad: STATIC_MAX_SLOPE_RAD,
+            hold_railings: true,
             command_lead_max_rad: 0.05,
             unload_foot_weight: 100.0,
             tipping_detection_rad: 0.25,
@@ -329,12 +334,14 @@ pub enum ConfigError {
 }
 
 impl ControllerConfig {
-    /// The terrain the static gait takes (`max_step_up_m`, `max_step_down_m`, `max_slope_rad`).
-    pub fn terrain_limits(&self) -> TerrainLimits {
-        TerrainLimits {
+    /// The scene the static gait takes (`max_step_up_m`, `max_step_down_m`, `max_slope_rad`,
+    /// `hold_railings`).
+    pub fn scene_limits(&self) -> SceneLimits {
+        SceneLimits {
             up: self.max_step_up_m,
             down: self.max_step_down_m,
             slope: self.max_slope_rad,
+            hold_railings: self.hold_railings,
             section: "[controller]",
         }
     }

@@ -61,7 +61,7 @@ use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector2, Vector
 
 pub use config::{ConfigError, ControllerConfig};
 pub use gait::{DynamicGaitConfig, GaitConfig, StabilizerConfig};
-pub use sequence::{PreparedSequence, Refusal, TerrainLimits};
+pub use sequence::{PreparedSequence, Refusal, SceneLimits};
 pub use stance::Gait;
 pub use status::{
     BalanceStatus, ControllerState, ControllerStatus, FaultCode, FaultDescription,
@@ -317,7 +317,7 @@ impl Controller {
         config: &ControllerConfig,
         seq: &stance::PostProcessedSequence,
     ) -> Result<PreparedSequence, Refusal> {
-        PreparedSequence::new(robot, config, &config.terrain_limits(), seq)
+        PreparedSequence::new(robot, config, &config.scene_limits(), seq)
     }
 
     /// Non-RT: [`prepare`](Self::prepare) for `gait`; a dynamic walk is also planned here (its
@@ -334,7 +334,7 @@ impl Controller {
             return Self::prepare(robot, config, seq);
         };
         let dynamic = gaits.dynamic().map_err(|e| Refusal(e.to_string()))?;
-        let mut prepared = PreparedSequence::new(robot, config, &dynamic.terrain_limits(), seq)?;
+        let mut prepared = PreparedSequence::new(robot, config, &dynamic.scene_limits(), seq)?;
         let plan = DynamicPlan::new(
             robot,
             &prepared.stances,

@@ -15,22 +15,27 @@ const LIMIT_TOLERANCE: f64 = 1e-6;
 /// of exactly the limit passes, whatever the round-off of the soles' placement.
 const HEIGHT_TOLERANCE_M: f64 = 1e-4;
 
-/// The terrain a gait is set to take: the highest step up and down (m) a foot may land above or
+/// The scene a gait is set to take: the highest step up and down (m) a foot may land above or
 /// below the other foot's sole (a stair's riser), the steepest surface (rad) a sole may stand on,
-/// and the config section that sets them (named in a refusal). A stair or ramp a robot's legs
-/// cannot take tips it over at the first stair (JVRC-1's dynamic gait up and down 0.185 m
-/// stairs, MuJoCo) or lets it fall on the slope (ARMAR-4's static gait on the 10° ramp), after
-/// which a held robot falls: refused before anything moves.
+/// whether a hand may hold a railing, and the config section that sets them (named in a
+/// refusal). A stair or ramp a robot's legs cannot take tips it over at the first stair (JVRC-1's
+/// dynamic gait up and down 0.185 m stairs, MuJoCo) or lets it fall on the slope (ARMAR-4's
+/// static gait on the 10° ramp), and a hand on a railing a gait cannot walk with pulls the robot
+/// over (JVRC-1's dynamic gait, ARMAR-4's both), after which a held robot falls: refused before
+/// anything moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TerrainLimits {
+pub struct SceneLimits {
     /// Highest step up (m).
     pub up: f64,
     /// Highest step down (m).
     pub down: f64,
     /// Steepest sole in contact, its tilt from horizontal (rad).
     pub slope: f64,
-    /// The section holding `max_step_up_m`, `max_step_down_m` and `max_slope_rad`
-    /// (`[controller]`, `[gait.dynamic]`).
+    /// Whether a hand may be in contact in a sequence whose scene has railings (the hand then
+    /// holds one).
+    pub hold_railings: bool,
+    /// The section holding `max_step_up_m`, `max_step_down_m`, `max_slope_rad` and
+    /// `hold_railings` (`[controller]`, `[gait.dynamic]`).
     pub section: &'static str,
 }
 
@@ -103,12 +108,13 @@ impl PreparedSequence {
     ///
     /// Refused: another robot or joint order, an empty sequence, a non-finite value, a posture
     /// beyond a joint limit, a stance without foot support, a step between consecutive contacts
-    /// of one foot longer than `config.max_step_m`, or higher up or down than `terrain` allows,
-    /// or a sole in contact on a slope steeper than it (the gait's).
+    /// of one foot longer than `config.max_step_m`, or higher up or down than `scene` allows, a
+    /// sole in contact on a slope steeper than it, or a hand held on a railing it does not hold
+    /// (the gait's).
     pub fn new(
         robot: &Robot,
         config: &ControllerConfig,
-        terrain: &TerrainLimits,
+        scene: &SceneLimits,
         seq: &stance::PostProcessedSequence,
     ) -> Result<Self, Refusal> {
         seq.check_robot(robot)
@@ -166,20 +172,48 @@ impl PreparedSequence {
                 duration_s: seq.stances()[i].duration_s,
             });
         }
-        check_steps(&stances, config.max_step_m, terrain)?;
-        check_slopes(&stances, terrain)?;
+        check_steps(&stances, config.max_step_m, scene)?;
+        check_slopes(&stances, scene)?;
         check_workspace(&stances, config)?;
+        let railings = RailAxis::of_scene(&seq.environment().hand_affordances);
+        if !railings.is_empty() {
+            check_held_hands(&stances, scene)?;
+        }
         Ok(Self {
             stances,
             dynamic: None,
-            railings: RailAxis::of_scene(&seq.environment().hand_affordances),
+            railings,
         })
     }
 }
 
-/// Refuses a foot in contact whose sole is tilted from horizontal more than `terrain.slope`: a
+/// Refuses, in a scene with railings, a hand in contact (holding one) where `scene.hold_railings`
+/// is off: the gait has not been measured to walk with a hand on a railing. Without railings a
+/// held hand touches nothing and stays a pose task, which every gait walks.
+fn check_held_hands(stances: &[PreparedStance], scene: &SceneLimits) -> Result<(), Refusal> {
+    if scene.hold_railings {
+        return Ok(());
+    }
+    for (i, stance) in stances.iter().enumerate() {
+        if let Some(hand) = EndEffector::HANDS
+            .into_iter()
+            .find(|hand| stance.contacts[*hand as usize])
+        {
+            return Err(Refusal(format!(
+                "stance {i}: {} holds a railing, which {} hold_railings = false refuses: this \
+                 gait is not set to walk with a hand on a railing; walk with the feet alone \
+                 (--affordances feet) (docs/scenes.md, \"Hands on railings\")",
+                hand.name(),
+                scene.section
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a foot in contact whose sole is tilted from horizontal more than `scene.slope`: a
 /// surface steeper than the gait is set to stand on.
-fn check_slopes(stances: &[PreparedStance], terrain: &TerrainLimits) -> Result<(), Refusal> {
+fn check_slopes(stances: &[PreparedStance], scene: &SceneLimits) -> Result<(), Refusal> {
     for (i, stance) in stances.iter().enumerate() {
         for foot in [EndEffector::LeftFoot, EndEffector::RightFoot] {
             if !stance.contacts[foot as usize] {
@@ -187,15 +221,15 @@ fn check_slopes(stances: &[PreparedStance], terrain: &TerrainLimits) -> Result<(
             }
             let normal = stance.targets[foot as usize].rotation * Vector3::z();
             let tilt = normal.angle(&Vector3::z());
-            if tilt > terrain.slope + SLOPE_TOLERANCE_RAD {
+            if tilt > scene.slope + SLOPE_TOLERANCE_RAD {
                 return Err(Refusal(format!(
                     "stance {i}: {} stands on a slope of {tilt:.3} rad ({:.1}°), more than {} \
                      max_slope_rad = {}, the steepest slope this gait is set to stand on \
                      (docs/scenes.md, \"Step heights\")",
                     foot.name(),
                     tilt.to_degrees(),
-                    terrain.section,
-                    terrain.slope
+                    scene.section,
+                    scene.slope
                 )));
             }
         }
@@ -257,13 +291,13 @@ fn check_workspace(stances: &[PreparedStance], config: &ControllerConfig) -> Res
 }
 
 /// Refuses steps (between consecutive contact poses of one foot) longer than `max_step`, or
-/// landing higher or lower than `terrain` allows above or below the sole of the other foot,
+/// landing higher or lower than `scene` allows above or below the sole of the other foot,
 /// the one the robot stands on while this one swings: the step a stair's riser makes, whether
 /// the feet go one per stair (a foot then travels two risers) or both on each.
 fn check_steps(
     stances: &[PreparedStance],
     max_step: f64,
-    terrain: &TerrainLimits,
+    scene: &SceneLimits,
 ) -> Result<(), Refusal> {
     use EndEffector::{LeftFoot, RightFoot};
     for (foot, other) in [(LeftFoot, RightFoot), (RightFoot, LeftFoot)] {
@@ -292,9 +326,9 @@ fn check_steps(
                 };
                 let rise = pose.translation.z - support.translation.z;
                 let (way, height, limit) = if rise >= 0.0 {
-                    ("up", rise, terrain.up)
+                    ("up", rise, scene.up)
                 } else {
-                    ("down", -rise, terrain.down)
+                    ("down", -rise, scene.down)
                 };
                 if height > limit + HEIGHT_TOLERANCE_M {
                     return Err(Refusal(format!(
@@ -302,7 +336,7 @@ fn check_steps(
                          than {} max_step_{way}_m = {limit}, the highest step this gait is set to \
                          take (docs/scenes.md, \"Step heights\")",
                         foot.name(),
-                        terrain.section
+                        scene.section
                     )));
                 }
             }
