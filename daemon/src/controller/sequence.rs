@@ -176,9 +176,7 @@ impl PreparedSequence {
         check_slopes(&stances, scene)?;
         check_workspace(&stances, config)?;
         let railings = RailAxis::of_scene(&seq.environment().hand_affordances);
-        if !railings.is_empty() {
-            check_held_hands(&stances, scene)?;
-        }
+        check_held_hands(&stances, &railings, scene)?;
         Ok(Self {
             stances,
             dynamic: None,
@@ -187,11 +185,15 @@ impl PreparedSequence {
     }
 }
 
-/// Refuses, in a scene with railings, a hand in contact (holding one) where `scene.hold_railings`
-/// is off: the gait has not been measured to walk with a hand on a railing. Without railings a
-/// held hand touches nothing and stays a pose task, which every gait walks.
-fn check_held_hands(stances: &[PreparedStance], scene: &SceneLimits) -> Result<(), Refusal> {
-    if scene.hold_railings {
+/// Refuses, in a scene with `railings`, a hand in contact (holding one) where
+/// `scene.hold_railings` is off: the gait has not been measured to walk with a hand on a railing.
+/// Without railings a held hand touches nothing and stays a pose task, which every gait walks.
+fn check_held_hands(
+    stances: &[PreparedStance],
+    railings: &[RailAxis],
+    scene: &SceneLimits,
+) -> Result<(), Refusal> {
+    if railings.is_empty() || scene.hold_railings {
         return Ok(());
     }
     for (i, stance) in stances.iter().enumerate() {
