@@ -54,6 +54,9 @@ pub(crate) struct QpAssembler {
     polygon: SupportPolygon,
     /// Whether each joint belongs to `[robot.joint_groups] torso`.
     torso_joints: Vec<bool>,
+    /// Whether each joint is a torso joint turning the upper body about the vertical
+    /// (`torso_yaw_posture_weight`).
+    torso_yaw_joints: Vec<bool>,
     /// Whether each joint belongs to `[robot.joint_groups] legs`.
     leg_joints: Vec<bool>,
     /// Whether each joint moves each hand (left, right) and is no torso joint: its arm.
@@ -94,6 +97,11 @@ impl QpAssembler {
         let torso_joints: Vec<bool> = (0..model.dof())
             .map(|j| robot.joint_groups.torso.contains(&j))
             .collect();
+        let torso_yaw_joints = vertical_axes(robot, &mut kinematics, &mut jacobian)
+            .into_iter()
+            .zip(&torso_joints)
+            .map(|(vertical, &torso)| vertical && torso)
+            .collect();
         let arm_joints = EndEffector::HANDS.map(|hand| {
             (0..model.dof())
                 .map(|j| nonzero[hand as usize][6 + j] && !torso_joints[j])
@@ -116,6 +124,7 @@ impl QpAssembler {
             upright_reference: robot.standing.base.rotation,
             polygon: SupportPolygon::empty(),
             torso_joints,
+            torso_yaw_joints,
             leg_joints: (0..model.dof())
                 .map(|j| robot.joint_groups.legs.contains(&j))
                 .collect(),
@@ -247,6 +256,9 @@ impl QpAssembler {
         for j in 0..model.dof() {
             let weight = match targets.torso_posture_weight {
                 Some(weight) if self.torso_joints[j] => weight,
+                _ if self.torso_yaw_joints[j] => config
+                    .torso_yaw_posture_weight
+                    .unwrap_or(config.posture_weight),
                 _ => config.posture_weight,
             };
             let carrying_arm = (0..2).any(|h| carrying[h] && self.arm_joints[h][j]);
@@ -336,6 +348,33 @@ impl QpAssembler {
             x_max[6 + j] = upper.max(lower);
         }
     }
+}
+
+/// A joint axis this close to the vertical (rad) turns what it carries about the vertical.
+const VERTICAL_AXIS_RAD: f64 = std::f64::consts::FRAC_PI_6;
+
+/// Whether each joint's axis lies within [`VERTICAL_AXIS_RAD`] of the vertical in the standing
+/// posture, read off the hands' Jacobians (a revolute joint's angular column is its axis in the
+/// world); a joint that moves neither hand reads false.
+fn vertical_axes(
+    robot: &Robot,
+    kinematics: &mut Kinematics,
+    jacobian: &mut DMatrix<f64>,
+) -> Vec<bool> {
+    let model = &robot.model;
+    kinematics.update(model, &robot.standing);
+    let mut vertical = vec![false; model.dof()];
+    for hand in EndEffector::HANDS {
+        kinematics.frame_jacobian(model, robot.frame(hand), jacobian);
+        for (j, flag) in vertical.iter_mut().enumerate() {
+            let axis = jacobian.fixed_view::<3, 1>(3, 6 + j).into_owned();
+            if axis.norm() > 0.5 {
+                *flag |=
+                    axis.angle(&Vector3::z()).min(axis.angle(&-Vector3::z())) < VERTICAL_AXIS_RAD;
+            }
+        }
+    }
+    vertical
 }
 
 /// Desired frame velocity: feed-forward plus proportional correction of the pose error.
@@ -466,6 +505,34 @@ mod tests {
         );
         assert!(!knee, "a stance's knee angle pulls the knee");
         assert!(elbow, "the stance's elbow angle does not pull the elbow");
+    }
+
+    #[test]
+    fn the_torso_yaw_posture_weight_holds_the_waist_joints_that_turn_about_the_vertical() {
+        let (robot, config) = jvrc1();
+        let joint = |name| robot.model.joint_index(name).expect("a JVRC-1 joint");
+        let assembler = QpAssembler::new(&robot);
+        let yaw = |name| assembler.torso_yaw_joints[joint(name)];
+        assert!(yaw("WAIST_Y"));
+        assert!(!yaw("WAIST_P") && !yaw("WAIST_R") && !yaw("R_HIP_Y") && !yaw("NECK_Y"));
+        // The stance's waist yaw pulls 10 times as hard at 10 times the weight, its pitch not
+        // at all harder.
+        let pull = |config: &ControllerConfig, name| {
+            let standing = robot.standing.joints.clone();
+            let mut moved = standing.clone();
+            moved[joint(name)] -= 0.5;
+            let targets = Targets::none();
+            let a = linear_term(&robot, config, &standing, &targets);
+            let b = linear_term(&robot, config, &moved, &targets);
+            (a[6 + joint(name)] - b[6 + joint(name)]).abs()
+        };
+        let held = ControllerConfig {
+            torso_yaw_posture_weight: Some(10.0 * config.posture_weight),
+            ..config
+        };
+        let ratio = pull(&held, "WAIST_Y") / pull(&config, "WAIST_Y");
+        assert!((ratio - 10.0).abs() < 1e-9, "{ratio}");
+        assert!((pull(&held, "WAIST_P") - pull(&config, "WAIST_P")).abs() < 1e-12);
     }
 
     #[test]

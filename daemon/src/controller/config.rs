@@ -33,6 +33,13 @@ pub struct ControllerConfig {
     pub torso_weight: f64,
     /// Weight of the posture task towards the stance's joint angles (low: moves the upper body).
     pub posture_weight: f64,
+    /// Replaces `posture_weight` on the torso joints that turn the upper body about the vertical
+    /// (their axis within 30° of it standing), unless the dynamic gait's `torso_posture_weight`
+    /// replaces it on every torso joint; absent: `posture_weight`. At ARMAR-4's 0.01 the QP
+    /// shifted its CoM sideways by swinging the waist round, ±0.8 rad at every static step on
+    /// the flat (its ankle roll cannot shift it); at 0.03 its static stairs walk 10/10 up and
+    /// down (docs/controller.md, "Waist yaw").
+    pub torso_yaw_posture_weight: Option<f64>,
     /// λ of the λ‖ν‖² regulariser that keeps P positive definite.
     pub regularization: f64,
     /// Proportional gain of the CoM task (1/s).
@@ -232,6 +239,7 @@ impl Default for ControllerConfig {
             hand_weight: 1.0,
             torso_weight: 1.0,
             posture_weight: 1e-2,
+            torso_yaw_posture_weight: None,
             regularization: 1e-5,
             com_gain: 10.0,
             pose_gain: 20.0,
@@ -386,6 +394,12 @@ impl ControllerConfig {
             Bound::new("hand_weight", self.hand_weight, 1e-6, 1e6),
             Bound::new("torso_weight", self.torso_weight, 1e-6, 1e6),
             Bound::new("posture_weight", self.posture_weight, 1e-6, 1e6),
+            Bound::optional(
+                "torso_yaw_posture_weight",
+                self.torso_yaw_posture_weight,
+                1e-6,
+                1e6,
+            ),
             Bound::new("unload_foot_weight", self.unload_foot_weight, 1e-6, 1e6),
             Bound::new("regularization", self.regularization, 1e-12, 1.0),
             Bound::new("com_gain", self.com_gain, 0.01, 1000.0),
