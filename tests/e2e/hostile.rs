@@ -122,9 +122,21 @@ fn a_sample_stamped_in_the_future_does_not_freeze_the_control_thread() {
             walkd.log()
         );
     }
-    let client = walk_tests::connect(&prefix).unwrap();
-    let status = client.status().unwrap();
+    // The link is read while ordinary samples still flow: once they stop, it goes stale within
+    // the watchdog time (20 ms), sooner than a loaded machine may connect a client.
+    let status = std::thread::scope(|scope| {
+        let reader = scope.spawn(|| {
+            let client = walk_tests::connect(&prefix).unwrap();
+            std::thread::sleep(Duration::from_millis(100));
+            client.status().unwrap()
+        });
+        while !reader.is_finished() {
+            adapter.stream(&standing, PERIOD, Duration::from_millis(100));
+        }
+        reader.join().unwrap()
+    });
     assert_eq!(status.link, LinkState::Fresh, "{status:?}");
+    let client = walk_tests::connect(&prefix).unwrap();
     let json = client::daemon_client::status_json(&status);
     assert!(json["rejected_samples"].as_u64() >= Some(3), "{json}");
     assert!(status.stale_periods < 1_000_000, "{status:?}");
