@@ -368,10 +368,8 @@ fn vertical_axes(
         kinematics.frame_jacobian(model, robot.frame(hand), jacobian);
         for (j, flag) in vertical.iter_mut().enumerate() {
             let axis = jacobian.fixed_view::<3, 1>(3, 6 + j).into_owned();
-            if axis.norm() > 0.5 {
-                *flag |=
-                    axis.angle(&Vector3::z()).min(axis.angle(&-Vector3::z())) < VERTICAL_AXIS_RAD;
-            }
+            let norm = axis.norm();
+            *flag |= norm > 0.5 && axis.z.abs() > norm * VERTICAL_AXIS_RAD.cos();
         }
     }
     vertical
