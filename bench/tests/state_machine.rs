@@ -774,9 +774,9 @@ fn prepare_on_scene_with(
 }
 
 /// A surface steeper than a gait is set to stand on (`max_slope_rad`) is refused before anything
-/// moves, naming the stance, the foot, the slope and the key: ARMAR-4's static gait, level soles
-/// only (on the 10° ramp it walked 2 of 10 walks, and fell in one with no fault first), refuses
-/// the ramp its steps (at most 0.05 m) would take; JVRC-1's walks it.
+/// moves, naming the stance, the foot, the slope and the key: ARMAR-4's static gait, set to 5°
+/// slopes (on the 10° ramp it walked 2 of 10 walks, and fell in one with no fault first), takes
+/// the 5° ramp and refuses the 10° one its steps (at most 0.05 m) would take; JVRC-1's walks it.
 #[test]
 fn a_ramp_steeper_than_a_gait_takes_is_refused_naming_the_slope_and_the_key() {
     use stance::Gait;
@@ -792,11 +792,15 @@ fn a_ramp_steeper_than_a_gait_takes_is_refused_naming_the_slope_and_the_key() {
         prepare_on_scene("armar4", "stairs-up-10cm.toml", Gait::Static),
         Ok(())
     );
+    assert_eq!(
+        prepare_on_scene("armar4", "ramp-5deg.toml", Gait::Static),
+        Ok(())
+    );
     let refusal = prepare_on_scene("armar4", "ramp-10deg.toml", Gait::Static).unwrap_err();
     assert!(
         refusal.starts_with("sequence refused: stance ")
             && refusal.contains("foot stands on a slope of 0.175 rad (10.0°)")
-            && refusal.contains("[controller] max_slope_rad = 0,"),
+            && refusal.contains("[controller] max_slope_rad = 0.09,"),
         "{refusal}"
     );
 }

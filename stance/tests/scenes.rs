@@ -61,6 +61,7 @@ fn every_committed_scene_loads() {
         "railing-left",
         "ramp-10deg",
         "ramp-15deg",
+        "ramp-5deg",
         "stairs-down-10cm",
         "stairs-down-15cm",
         "stairs-down-18cm",

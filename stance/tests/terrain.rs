@@ -13,7 +13,7 @@ use kinematics::ConfigFile;
 use kinematics::robot::{EndEffector, Robot};
 use nalgebra::{Isometry3, Point3, Vector3};
 use stance::derived::{steps, swing_reference};
-use stance::passes::{HEEL_MARGIN_M, SHORT_SURFACE_SOLES, TOE_MARGIN_M, path_of};
+use stance::passes::{HEEL_MARGIN_M, KINK_MARGIN_M, SHORT_SURFACE_SOLES, TOE_MARGIN_M, path_of};
 use stance::poses::FEET;
 use stance::{
     AffordanceSet, Environment, Gait, GenerateOptions, PoseSequence, PostProcessParams,
@@ -122,19 +122,43 @@ fn depth(surface: &SupportSurface, y: f64) -> f64 {
     to - from
 }
 
-/// The room a sole keeps ahead of its toe: none where the surface ends at a drop (what lies
-/// just past the margin is 0.02 m or more lower, a stair going down), else `TOE_MARGIN_M`.
-fn toe_margin(environment: &Environment, pose: &Isometry3<f64>, length: f64) -> f64 {
-    let ahead = pose * Point3::new(length / 2.0 + TOE_MARGIN_M, 0.0, 0.0);
-    let lower_ahead = environment
-        .highest_at(ahead.x, ahead.y)
-        .is_some_and(|z| z <= pose.translation.z - 0.02);
-    if lower_ahead { 0.0 } else { TOE_MARGIN_M }
+/// The room a sole on `surface` keeps from its surface's edges, `(heel, toe)`: where the
+/// neighbouring surface meets it edge to edge at its height (a kink: a ramp's foot or top)
+/// `KINK_MARGIN_M`; before a drop (the next surface begins 0.02 m or more lower, a stair going
+/// down) none at the toe; else `HEEL_MARGIN_M` and `TOE_MARGIN_M`.
+fn margins(
+    environment: &Environment,
+    surface: &SupportSurface,
+    pose: &Isometry3<f64>,
+) -> (f64, f64) {
+    let y = pose.translation.y;
+    let along = |s: &SupportSurface| s.extent_along(&Vector3::new(0.0, y, 0.0), &Vector3::x());
+    let [from, to] = along(surface).unwrap();
+    let edge = |s: &SupportSurface, x: f64| s.elevation_at(x, y).unwrap();
+    let (start, end) = (edge(surface, from + 1e-6), edge(surface, to - 1e-6));
+    let mut margins = (HEEL_MARGIN_M, TOE_MARGIN_M);
+    for other in &environment.surfaces {
+        let Some([other_from, other_to]) = along(other) else {
+            continue;
+        };
+        if (other_to - from).abs() < 1e-3 && (edge(other, other_to - 1e-6) - start).abs() < 0.02 {
+            margins.0 = KINK_MARGIN_M;
+        }
+        if (other_from - to).abs() < 1e-3 {
+            let drop = end - edge(other, other_from + 1e-6);
+            if drop >= 0.02 {
+                margins.1 = 0.0;
+            } else if drop.abs() < 0.02 {
+                margins.1 = KINK_MARGIN_M;
+            }
+        }
+    }
+    margins
 }
 
 /// Every contact sole: on its surface's plane, parallel to it, with the sole's heel and toe on
-/// the same surface with the margins (corners of the sole, lengthened by the margins; no toe
-/// margin before a drop).
+/// the same surface with the margins (corners of the sole, lengthened by the margins: the
+/// kink's where a neighbour meets the surface at its height, no toe margin before a drop).
 fn check_soles_fit(poses: &PoseSequence, environment: &Environment, sole: [f64; 2]) {
     let [length, width] = sole;
     for i in 0..poses.len() {
@@ -156,8 +180,9 @@ fn check_soles_fit(poses: &PoseSequence, environment: &Environment, sole: [f64; 
                 "stance {i} {foot:?} tilted {tilt} on {}",
                 surface.name
             );
-            let heel = -length / 2.0 - HEEL_MARGIN_M + EPS;
-            let toe = length / 2.0 + toe_margin(environment, pose, length) - EPS;
+            let (heel_margin, toe_margin) = margins(environment, surface, pose);
+            let heel = -length / 2.0 - heel_margin + EPS;
+            let toe = length / 2.0 + toe_margin - EPS;
             for (x, y) in [
                 (heel, width / 2.0),
                 (heel, -width / 2.0),
@@ -396,6 +421,7 @@ fn a_step_limit_under_two_treads_puts_both_feet_on_every_tread() {
 #[test]
 fn ramp_soles_are_pitched_with_the_ramp() {
     check_ramp("ramp-10deg", 10.0);
+    check_ramp("ramp-5deg", 5.0);
 }
 
 #[test]

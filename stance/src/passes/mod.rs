@@ -19,7 +19,9 @@ pub use hands::hold_hand_affordances;
 pub use height::limit_swing_foot_height;
 pub use orientation::{contact_feet_parallel_to_surface, limit_swing_foot_rotation};
 pub use path::{limit_orthogonal_feet_distance, limit_to_max_step_size, scale_translation};
-pub use terrain::{HEEL_MARGIN_M, SHORT_SURFACE_SOLES, TOE_MARGIN_M, place_on_terrain};
+pub use terrain::{
+    HEEL_MARGIN_M, KINK_MARGIN_M, SHORT_SURFACE_SOLES, TOE_MARGIN_M, place_on_terrain,
+};
 
 use kinematics::robot::{Robot, SoleRectangle};
 

@@ -37,6 +37,19 @@ pub const TOE_MARGIN_M: f64 = 0.03;
 /// the nosing of a stair going down; a ramp's kink or a floor's seam does not.
 const DROP_M: f64 = 0.02;
 
+/// Room (m) left at a kink, in place of [`HEEL_MARGIN_M`] or [`TOE_MARGIN_M`]: where the
+/// neighbouring surface meets this one edge to edge at the same height (within [`DROP_M`] and
+/// [`SEAM_M`]), at another slope or the same. There is no riser to meet and no edge to land on:
+/// a sole that overshoots the kink by d only tilts onto the neighbour, by at most d · sin of the
+/// kink's angle (5 mm for 3 cm across a 10° ramp's foot). With the stair margins the step across
+/// the foot of a 5° ramp was 0.35 m, and ARMAR-4's static gait stopped there standing in 3 of 4
+/// walks, its landing foot 1–2 mm above the floor with the standing ankle and waist pitch at their
+/// bounds (MuJoCo); with 0.01 m 19 of 20 walks end `done`.
+pub const KINK_MARGIN_M: f64 = 0.01;
+
+/// Two surfaces whose edges along the path are this close (m) meet: a kink or a seam, not a gap.
+const SEAM_M: f64 = 1e-3;
+
 /// A foot this close (m) to the end of its surface's fit interval has come up to the edge.
 const EDGE_REACHED_M: f64 = 0.01;
 
@@ -69,10 +82,11 @@ pub const SHORT_SURFACE_SOLES: f64 = 2.0;
 ///    its surface's fit interval along the path: where the sole, lengthened by
 ///    [`HEEL_MARGIN_M`] behind and [`TOE_MARGIN_M`] ahead, lies over the surface — for a sole
 ///    along the path and a surface edge across it, `[start + HEEL_MARGIN_M + L/2, end −
-///    TOE_MARGIN_M − L/2]`; a toed-out sole's corners reach further (its middle if the sole does
-///    not fit). A landing the clamp would take back by more than half its advance on the other
-///    foot goes on to the next surface instead: short steps would otherwise stall at an edge,
-///    each landing short of it.
+///    TOE_MARGIN_M − L/2]`, no toe margin before a drop and [`KINK_MARGIN_M`] at either end
+///    where a neighbouring surface meets this one at its height; a toed-out sole's corners
+///    reach further (its middle if the sole does not fit). A landing the clamp would take back
+///    by more than half its advance on the other foot goes on to the next surface instead:
+///    short steps would otherwise stall at an edge, each landing short of it.
 ///    A landing's shift moves everything after it, as pass 7's do (`shift_landings`), so a
 ///    step made longer by rule (ii) can exceed `s_max`: a tread deeper than `s_max` is a step
 ///    of its depth whatever the rule.
@@ -150,6 +164,27 @@ impl Extent {
     }
 }
 
+/// What lies past an end of a surface along the path, which sets the room a sole keeps from it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Edge {
+    /// The next surface begins [`DROP_M`] or more lower: no room at the toe.
+    Drop,
+    /// The neighbouring surface meets it edge to edge at its height: [`KINK_MARGIN_M`].
+    Kink,
+    /// A riser, a gap or the end of the terrain: the full margin.
+    Other,
+}
+
+/// The edge where one surface ends at `(to, end)` (along the path, elevation) and the next
+/// begins at `(from, start)`: a kink if they meet there, within [`SEAM_M`] and [`DROP_M`].
+fn edge_between(to: f64, end: f64, from: f64, start: f64) -> Edge {
+    if (from - to).abs() <= SEAM_M && (end - start).abs() < DROP_M {
+        Edge::Kink
+    } else {
+        Edge::Other
+    }
+}
+
 /// The landing rule of the terrain pass (rules i–iii of [`place_on_terrain`]).
 struct Footholds<'a> {
     environment: &'a Environment,
@@ -202,6 +237,13 @@ impl Footholds<'_> {
         self.extents(lateral)
             .filter(|e| e.from > behind.from)
             .min_by(|a, b| a.from.total_cmp(&b.from))
+    }
+
+    /// The surface before `ahead` along the line `lateral`: the last to start before it.
+    fn previous(&self, ahead: &Extent, lateral: f64) -> Option<Extent> {
+        self.extents(lateral)
+            .filter(|e| e.from < ahead.from)
+            .max_by(|a, b| a.from.total_cmp(&b.from))
     }
 
     /// The surface foot `f` lands on (rules i and ii), and whether it lands there beside the
@@ -294,23 +336,34 @@ impl Footholds<'_> {
         self.environment.surfaces[k].plane_elevation_at(point.x, point.y)
     }
 
-    /// Whether surface `k` ends at a drop along the line `lateral` ([`DROP_M`]): the surface
-    /// after it begins that much lower than `k` ends.
-    fn ends_at_a_drop(&self, k: usize, lateral: f64) -> bool {
-        let Some(extent) = self.extent(k, lateral) else {
-            return false;
-        };
-        let Some(next) = self.next(&extent, lateral) else {
-            return false;
-        };
-        let (end, start) = (
-            self.elevation(k, extent.to, lateral),
-            self.elevation(next.surface, next.from, lateral),
-        );
-        match (end, start) {
-            (Some(end), Some(start)) => end - start >= DROP_M,
-            _ => false,
-        }
+    /// What ends surface `k` ahead along the line `lateral`: a drop ([`DROP_M`]) where the surface
+    /// after it begins that much lower, a kink where it meets it at its own height.
+    fn edge_ahead(&self, k: usize, lateral: f64) -> Edge {
+        self.extent(k, lateral)
+            .and_then(|extent| {
+                let next = self.next(&extent, lateral)?;
+                let end = self.elevation(k, extent.to, lateral)?;
+                let start = self.elevation(next.surface, next.from, lateral)?;
+                Some(if end - start >= DROP_M {
+                    Edge::Drop
+                } else {
+                    edge_between(extent.to, end, next.from, start)
+                })
+            })
+            .unwrap_or(Edge::Other)
+    }
+
+    /// What begins surface `k` behind along the line `lateral`: a kink where the surface before
+    /// it ends at its own height.
+    fn edge_behind(&self, k: usize, lateral: f64) -> Edge {
+        self.extent(k, lateral)
+            .and_then(|extent| {
+                let previous = self.previous(&extent, lateral)?;
+                let end = self.elevation(previous.surface, previous.to, lateral)?;
+                let start = self.elevation(k, extent.from, lateral)?;
+                Some(edge_between(previous.to, end, extent.from, start))
+            })
+            .unwrap_or(Edge::Other)
     }
 
     /// Rule (iii): `along` clamped into surface `k`'s fit interval for `sole`: the sole centre
@@ -320,13 +373,17 @@ impl Footholds<'_> {
     /// the foot's landing.
     fn fit(&self, k: usize, along: f64, sole: &Isometry3<f64>) -> f64 {
         let lateral = self.path.lateral(&sole.translation.vector);
-        let toe_margin = if self.ends_at_a_drop(k, lateral) {
-            0.0
-        } else {
-            TOE_MARGIN_M
+        let toe_margin = match self.edge_ahead(k, lateral) {
+            Edge::Drop => 0.0,
+            Edge::Kink => KINK_MARGIN_M,
+            Edge::Other => TOE_MARGIN_M,
+        };
+        let heel_margin = match self.edge_behind(k, lateral) {
+            Edge::Kink => KINK_MARGIN_M,
+            Edge::Drop | Edge::Other => HEEL_MARGIN_M,
         };
         let (back, front) = (
-            -self.sole.length / 2.0 - HEEL_MARGIN_M,
+            -self.sole.length / 2.0 - heel_margin,
             self.sole.length / 2.0 + toe_margin,
         );
         let side = self.sole.width / 2.0;
@@ -509,7 +566,7 @@ mod tests {
     use crate::geometry::roll_pitch_yaw;
     use crate::passes::fixtures::{BOTH, LEFT, RIGHT, SOLE, block, rotated, stance, walk};
     use kinematics::robot::EndEffector::{LeftFoot, LeftHand, RightFoot, RightHand};
-    use nalgebra::UnitQuaternion;
+    use nalgebra::{Translation3, UnitQuaternion};
 
     /// A step limit that lets the walk put one foot per stair on [`stairs`] (steps of two
     /// treads, 0.6 m).
@@ -745,6 +802,48 @@ mod tests {
         place(&mut p, &drop(), 0.48, 1.0);
         let found = footholds(&p);
         assert_eq!(found[found.len() - 1], [0.4, 0.15], "{found:?}");
+    }
+
+    /// A 10° ramp down to x = 0.5, where it meets a floor at its height: a kink.
+    fn ramp_to_floor() -> Environment {
+        let pitch = 10f64.to_radians();
+        let half = 0.75 / pitch.cos();
+        Environment {
+            surfaces: vec![
+                SupportSurface {
+                    name: "ramp".into(),
+                    pose: Isometry3::from_parts(
+                        Translation3::new(-0.25, 0.0, 0.75 * pitch.tan()),
+                        UnitQuaternion::from_euler_angles(0.0, pitch, 0.0),
+                    ),
+                    polygon: Some(vec![[-half, -0.5], [half, -0.5], [half, 0.5], [-half, 0.5]]),
+                },
+                block("floor", 0.5, 3.0, 0.0),
+            ],
+            hand_affordances: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_foot_keeps_the_kink_margin_at_a_ramp_foot() {
+        // The left foot's landing at 0.45 on the ramp is clamped to end with its toe 0.01 m
+        // short of the kink (KINK_MARGIN_M, not the stair's 0.03 m): 0.39, on the ramp's plane.
+        // That shift takes the right foot's landing back to 0.56, and the floor's interval
+        // brings it to its heel 0.01 m past the kink: 0.61, where a stair's heel margin would
+        // have made it 0.65 and the step across the kink 0.28 m instead of 0.22 m.
+        let mut p = flat_walk(&[0.2, 0.45, 0.62]);
+        place(&mut p, &ramp_to_floor(), 0.48, 1.0);
+        let found = footholds(&p);
+        let ahead = 0.5 - SOLE.length / 2.0 - KINK_MARGIN_M;
+        let [x, z] = found[found.len() - 2];
+        assert!((x - ahead).abs() < 1e-9, "{found:?}");
+        assert!(
+            (z - (0.5 - ahead) * 10f64.to_radians().tan()).abs() < 1e-9,
+            "{found:?}"
+        );
+        let [x, z] = found[found.len() - 1];
+        let behind = 0.5 + KINK_MARGIN_M + SOLE.length / 2.0;
+        assert!((x - behind).abs() < 1e-9 && z == 0.0, "{found:?}");
     }
 
     #[test]
