@@ -67,7 +67,7 @@ fn every_committed_scene_builds_a_box_per_surface_and_a_capsule_per_railing() {
         .filter(|path| path.extension().is_some_and(|e| e == "toml"))
         .collect();
     files.sort();
-    assert_eq!(files.len(), 10, "{files:?}");
+    assert_eq!(files.len(), 11, "{files:?}");
     for name in ["jvrc1", "armar4"] {
         let robot = robot(name);
         for file in &files {
